@@ -1,0 +1,34 @@
+//! # tirroi-core
+//!
+//! The flight core of tirroi: `#![no_std]`, no heap, bounded memory known at compile
+//! time. It holds what a thermal-infrared (TIR) camera and the first image-processing
+//! step of a spacecraft's guidance, navigation and control (GNC) chain do on board:
+//! region-of-interest (ROI) detection on 328×248 frames of digital numbers (DN).
+//!
+//! - [`frame`]: a validated, borrowed view of a DN frame ([`Frame`]).
+//! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface and the four detectors
+//!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`].
+//!
+//! ## Memory per detector
+//!
+//! Each detector works in a [`roi::Scratch`] whose size is fixed at compile time; the
+//! caller owns it (a `static` on flight hardware, a local on the host). Bytes beyond
+//! the input frame, on x86-64 and on 32-bit Arm alike (asserted by tests):
+//!
+//! | detector | scratch type | bytes | budget |
+//! |---|---|---|---|
+//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] (≈ 14.5 KiB) | 16 KiB |
+//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] (≈ 9.9 KiB) | 16 KiB |
+//! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] (≈ 13.6 KiB) | 16 KiB |
+//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] (≈ 70.5 KiB) | 96 KiB |
+//!
+//! The exact figures are printed by `tirroi memory` and listed in the README.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod frame;
+pub mod roi;
+
+pub use frame::{Frame, FrameError};
+pub use roi::{BoxRule, DetectError, Detection, Detector, Method, Roi};

@@ -1,0 +1,393 @@
+//! Difference-of-Gaussians (DoG) blob detection (Lindeberg / Lowe, paper ref. [49]).
+//!
+//! 1. The frame is averaged over [`DOWNSAMPLE`]×[`DOWNSAMPLE`] blocks (82×62 pixels for
+//!    a reference frame): the target at 15–440 m spans 9–150 full pixels, so the
+//!    scales that matter survive, and the whole scale space fits in bounded memory.
+//! 2. Gaussian levels `G_i`, `σ_i = sigma0_px · sigma_ratio^i` (full-resolution
+//!    pixels), are computed one at a time with separable fixed-point kernels (Q15
+//!    weights summing exactly to 1, replicated borders). Only four levels are kept in
+//!    a ring: the three DoG layers an extremum test needs come from them.
+//! 3. The scale-normalised response `R_i = (G_i − G_{i+1}) · σ_i/σ_0` (bright blobs are
+//!    positive) is searched for local maxima over space and scale (3×3×3, `≥` every
+//!    neighbour present) with `R_i ≥ min_response_dn`. The strongest
+//!    [`MAX_BLOBS`] are kept.
+//! 4. Each blob is the square of half-side `⌈√2·σ_i⌉` around its centre; the union of
+//!    the blob squares is the foreground mask handed to the [`BoxRule`] (all blobs'
+//!    hull, or the largest group of overlapping blobs).
+//!
+//! Memory is six 82×62 `u16` planes (base, blur temporary, four levels) plus the blob
+//! list and the mask-to-box state: see [`SCRATCH_BYTES`].
+
+use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
+
+/// Block side of the downsampling, in pixels.
+pub const DOWNSAMPLE: usize = 4;
+/// Width of the downsampled plane (82 for 328 pixels).
+pub const PLANE_WIDTH: usize = FRAME_WIDTH.div_ceil(DOWNSAMPLE);
+/// Height of the downsampled plane (62 for 248 pixels).
+pub const PLANE_HEIGHT: usize = FRAME_HEIGHT.div_ceil(DOWNSAMPLE);
+const PLANE: usize = PLANE_WIDTH * PLANE_HEIGHT;
+/// Most Gaussian levels (so at most `MAX_LEVELS − 1` DoG layers).
+pub const MAX_LEVELS: u8 = 8;
+/// Largest Gaussian kernel radius, in downsampled pixels (3σ, σ ≤ 21.3 plane px).
+pub const MAX_RADIUS: usize = 64;
+/// Most blobs kept per frame (the strongest).
+pub const MAX_BLOBS: usize = 64;
+/// Fixed-point scale of the kernel weights (Q15).
+const ONE_Q15: u32 = 1 << 15;
+/// Fixed-point scale of the scale normalisation σ_i/σ_0 (Q4).
+const NORM_Q: i32 = 16;
+
+/// Parameters of the DoG blob detector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dog {
+    /// Smallest Gaussian σ, in full-resolution pixels, `≥ 1`. Default 4 (one plane
+    /// pixel).
+    pub sigma0_px: f32,
+    /// Ratio between consecutive σ, `> 1` (default 1.6, as Lowe and scikit-image).
+    pub sigma_ratio: f32,
+    /// Gaussian levels, 3..=[`MAX_LEVELS`] (default 7: σ = 4 … 67 px, blobs of
+    /// half-side 6 … 95 px).
+    pub levels: u8,
+    /// Smallest scale-normalised response of a blob, in DN (default 256).
+    pub min_response_dn: u32,
+    /// Mask-to-box rule (default [`BoxRule::AllForeground`]).
+    pub box_rule: BoxRule,
+}
+
+impl Default for Dog {
+    fn default() -> Self {
+        Dog {
+            sigma0_px: 4.0,
+            sigma_ratio: 1.6,
+            levels: 7,
+            min_response_dn: 256,
+            box_rule: BoxRule::AllForeground,
+        }
+    }
+}
+
+/// A detected blob: plane coordinates, level and response.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Blob {
+    /// Column in the downsampled plane.
+    pub x: u16,
+    /// Row in the downsampled plane.
+    pub y: u16,
+    /// DoG layer `i` (σ_i of the detector).
+    pub level: u8,
+    /// Scale-normalised response in DN × 16.
+    pub response: i32,
+}
+
+const NO_BLOB: Blob = Blob {
+    x: 0,
+    y: 0,
+    level: 0,
+    response: 0,
+};
+
+/// DoG's buffers.
+#[derive(Debug, Clone)]
+pub struct DogWork {
+    base: [u16; PLANE],
+    tmp: [u16; PLANE],
+    ring: [[u16; PLANE]; 4],
+    row_sum: [u32; PLANE_WIDTH],
+    kernel: [u32; 2 * MAX_RADIUS + 1],
+    blobs: [Blob; MAX_BLOBS],
+    blob_count: usize,
+    mask: [bool; FRAME_WIDTH],
+}
+
+/// The DoG detector's scratch memory.
+pub type DogScratch = Scratch<DogWork>;
+
+/// Bytes of [`DogScratch`] (budget: 96 KiB).
+pub const SCRATCH_BYTES: usize = core::mem::size_of::<DogScratch>();
+
+impl DogScratch {
+    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
+    pub const fn new() -> Self {
+        Scratch {
+            work: DogWork {
+                base: [0; PLANE],
+                tmp: [0; PLANE],
+                ring: [[0; PLANE]; 4],
+                row_sum: [0; PLANE_WIDTH],
+                kernel: [0; 2 * MAX_RADIUS + 1],
+                blobs: [NO_BLOB; MAX_BLOBS],
+                blob_count: 0,
+                mask: [false; FRAME_WIDTH],
+            },
+            roi: RoiBuilder::new(),
+        }
+    }
+
+    /// The blobs of the last [`Detector::detect`] call, strongest not first.
+    pub fn blobs(&self) -> &[Blob] {
+        &self.work.blobs[..self.work.blob_count]
+    }
+}
+
+impl Default for DogScratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Dog {
+    /// σ of Gaussian level `i`, in full-resolution pixels.
+    pub fn sigma_px(&self, i: u8) -> f32 {
+        let mut s = self.sigma0_px;
+        for _ in 0..i {
+            s *= self.sigma_ratio;
+        }
+        s
+    }
+
+    /// Half-side of the square of a blob found in DoG layer `i`, in pixels: `⌈√2·σ_i⌉`.
+    pub fn blob_radius_px(&self, i: u8) -> u16 {
+        libm::ceilf(core::f32::consts::SQRT_2 * self.sigma_px(i)) as u16
+    }
+
+    fn radius_plane(&self, i: u8) -> usize {
+        libm::ceilf(3.0 * self.sigma_px(i) / DOWNSAMPLE as f32) as usize
+    }
+}
+
+/// Fills `kernel[..2r+1]` with Q15 Gaussian weights of σ `sigma` (plane pixels) that
+/// sum exactly to 2^15; returns r.
+fn gaussian_kernel(sigma: f32, r: usize, kernel: &mut [u32]) -> usize {
+    let r = r.min(MAX_RADIUS);
+    let taps = &mut kernel[..2 * r + 1];
+    let mut total = 0.0f32;
+    let mut raw = [0.0f32; 2 * MAX_RADIUS + 1];
+    for (k, g) in raw[..2 * r + 1].iter_mut().enumerate() {
+        let d = k as f32 - r as f32;
+        *g = libm::expf(-0.5 * d * d / (sigma * sigma));
+        total += *g;
+    }
+    let mut sum = 0u32;
+    for (t, &g) in taps.iter_mut().zip(&raw[..2 * r + 1]) {
+        *t = libm::roundf(g / total * ONE_Q15 as f32) as u32;
+        sum += *t;
+    }
+    // The centre tap takes the rounding remainder (it is the largest weight).
+    taps[r] = (taps[r] + ONE_Q15).saturating_sub(sum);
+    r
+}
+
+/// One separable blur pass along lines of `len` samples `stride` apart: `dst = k ∗ src`
+/// with replicated borders, rounded to the nearest integer.
+fn blur_lines(
+    src: &[u16],
+    dst: &mut [u16],
+    lines: usize,
+    len: usize,
+    line_step: usize,
+    stride: usize,
+    kernel: &[u32],
+) {
+    let r = kernel.len() / 2;
+    for line in 0..lines {
+        let at = |i: usize| line * line_step + i * stride;
+        for i in 0..len {
+            let mut acc = ONE_Q15 / 2;
+            if i >= r && i + r < len {
+                for (k, &w) in kernel.iter().enumerate() {
+                    acc += w * u32::from(src[at(i + k - r)]);
+                }
+            } else {
+                for (k, &w) in kernel.iter().enumerate() {
+                    let j = (i + k).saturating_sub(r).min(len - 1);
+                    acc += w * u32::from(src[at(j)]);
+                }
+            }
+            dst[at(i)] = (acc >> 15) as u16;
+        }
+    }
+}
+
+impl Detector for Dog {
+    type Work = DogWork;
+    const NAME: &'static str = "dog";
+
+    fn validate(&self) -> Result<(), DetectError> {
+        if !(self.sigma0_px.is_finite() && self.sigma0_px >= 1.0) {
+            return Err(DetectError::InvalidParameter {
+                name: "sigma0_px",
+                expected: "a finite sigma of at least 1 pixel",
+            });
+        }
+        if !(self.sigma_ratio.is_finite() && self.sigma_ratio > 1.0) {
+            return Err(DetectError::InvalidParameter {
+                name: "sigma_ratio",
+                expected: "a finite ratio above 1",
+            });
+        }
+        if self.levels < 3 || self.levels > MAX_LEVELS {
+            return Err(DetectError::InvalidParameter {
+                name: "levels",
+                expected: "3..=8 Gaussian levels",
+            });
+        }
+        if self.radius_plane(self.levels - 1) > MAX_RADIUS {
+            return Err(DetectError::InvalidParameter {
+                name: "sigma0_px",
+                expected: "a largest sigma (sigma0_px * sigma_ratio^(levels-1)) of at most 85 px",
+            });
+        }
+        Ok(())
+    }
+
+    fn box_rule(&self) -> BoxRule {
+        self.box_rule
+    }
+
+    /// Foreground: the union of the blob squares. Threshold: `min_response_dn`.
+    fn foreground<F: FnMut(usize, &[bool])>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut DogWork,
+        mut sink: F,
+    ) -> u32 {
+        let (w, h) = (frame.width(), frame.height());
+        let (pw, ph) = (w.div_ceil(DOWNSAMPLE), h.div_ceil(DOWNSAMPLE));
+        downsample(frame, work, pw);
+        find_blobs(self, work, pw, ph);
+
+        let mut squares = [(0u16, 0u16, 0u16, 0u16); MAX_BLOBS];
+        for (sq, b) in squares.iter_mut().zip(&work.blobs[..work.blob_count]) {
+            let r = usize::from(self.blob_radius_px(b.level));
+            let cx = (usize::from(b.x) * DOWNSAMPLE + DOWNSAMPLE / 2).min(w - 1);
+            let cy = (usize::from(b.y) * DOWNSAMPLE + DOWNSAMPLE / 2).min(h - 1);
+            *sq = (
+                cx.saturating_sub(r) as u16,
+                cy.saturating_sub(r) as u16,
+                (cx + r + 1).min(w) as u16,
+                (cy + r + 1).min(h) as u16,
+            );
+        }
+        let squares = &squares[..work.blob_count];
+        let mask = &mut work.mask[..w];
+        for y in 0..h {
+            mask.fill(false);
+            for &(x0, y0, x1, y1) in squares {
+                if (usize::from(y0)..usize::from(y1)).contains(&y) {
+                    mask[usize::from(x0)..usize::from(x1)].fill(true);
+                }
+            }
+            sink(y, mask);
+        }
+        self.min_response_dn
+    }
+}
+
+/// Block means of the frame into `work.base` (`pw` plane pixels per row).
+fn downsample(frame: &Frame<'_>, work: &mut DogWork, pw: usize) {
+    let max_dn = frame.max_dn();
+    let h = frame.height();
+    let w = frame.width();
+    let row_sum = &mut work.row_sum[..pw];
+    for (py, band) in frame.pixels().chunks(w * DOWNSAMPLE).enumerate() {
+        row_sum.fill(0);
+        for row in band.chunks_exact(w) {
+            for (px, block) in row.chunks(DOWNSAMPLE).enumerate() {
+                row_sum[px] += block.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
+            }
+        }
+        let rows = (h - py * DOWNSAMPLE).min(DOWNSAMPLE);
+        for (px, &s) in row_sum.iter().enumerate() {
+            let cols = (w - px * DOWNSAMPLE).min(DOWNSAMPLE);
+            let n = (rows * cols) as u32;
+            work.base[py * pw + px] = ((s + n / 2) / n) as u16;
+        }
+    }
+}
+
+/// Gaussian level `i` into ring slot `i % 4`.
+fn gaussian_level(dog: &Dog, work: &mut DogWork, i: u8, pw: usize, ph: usize) {
+    let sigma = dog.sigma_px(i) / DOWNSAMPLE as f32;
+    let r = gaussian_kernel(sigma, dog.radius_plane(i), &mut work.kernel);
+    let kernel = &work.kernel[..2 * r + 1];
+    let n = pw * ph;
+    blur_lines(&work.base[..n], &mut work.tmp[..n], ph, pw, pw, 1, kernel);
+    let dst = &mut work.ring[usize::from(i) % 4][..n];
+    blur_lines(&work.tmp[..n], dst, pw, ph, 1, pw, kernel);
+}
+
+/// Scale-space maxima of the normalised DoG into `work.blobs`.
+fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
+    work.blob_count = 0;
+    let levels = dog.levels;
+    let layers = levels - 1;
+    let mut norm = [0i32; MAX_LEVELS as usize];
+    for (i, n) in norm.iter_mut().enumerate().take(usize::from(layers)) {
+        *n = libm::roundf(dog.sigma_px(i as u8) / dog.sigma0_px * NORM_Q as f32) as i32;
+    }
+    let min_response = i32::try_from(dog.min_response_dn)
+        .unwrap_or(i32::MAX)
+        .saturating_mul(NORM_Q);
+    gaussian_level(dog, work, 0, pw, ph);
+    gaussian_level(dog, work, 1, pw, ph);
+    for i in 0..layers {
+        if i + 2 < levels {
+            gaussian_level(dog, work, i + 2, pw, ph);
+        }
+        let response = |ring: &[[u16; PLANE]; 4], layer: u8, idx: usize| -> i32 {
+            let a = i32::from(ring[usize::from(layer) % 4][idx]);
+            let b = i32::from(ring[usize::from(layer + 1) % 4][idx]);
+            (a - b) * norm[usize::from(layer)]
+        };
+        let lo_layer = i.saturating_sub(1);
+        let hi_layer = (i + 1).min(layers - 1);
+        for y in 0..ph {
+            for x in 0..pw {
+                let r = response(&work.ring, i, y * pw + x);
+                if r < min_response || r <= 0 {
+                    continue;
+                }
+                let mut is_max = true;
+                'search: for layer in lo_layer..=hi_layer {
+                    for ny in y.saturating_sub(1)..=(y + 1).min(ph - 1) {
+                        for nx in x.saturating_sub(1)..=(x + 1).min(pw - 1) {
+                            if (layer, ny, nx) != (i, y, x)
+                                && response(&work.ring, layer, ny * pw + nx) > r
+                            {
+                                is_max = false;
+                                break 'search;
+                            }
+                        }
+                    }
+                }
+                if is_max {
+                    keep_blob(
+                        work,
+                        Blob {
+                            x: x as u16,
+                            y: y as u16,
+                            level: i,
+                            response: r,
+                        },
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Adds `blob`, or replaces the weakest kept blob when the list is full.
+fn keep_blob(work: &mut DogWork, blob: Blob) {
+    if work.blob_count < MAX_BLOBS {
+        work.blobs[work.blob_count] = blob;
+        work.blob_count += 1;
+        return;
+    }
+    if let Some(weakest) = work.blobs.iter_mut().min_by_key(|b| b.response) {
+        if weakest.response < blob.response {
+            *weakest = blob;
+        }
+    }
+}

@@ -1,0 +1,325 @@
+//! From a foreground mask, streamed row by row, to one box ([`BoxRule`]).
+//!
+//! The largest-component rule labels 8-connected components with a one-pass,
+//! run-length union-find that only remembers the previous row: the runs of the
+//! previous and the current row, and a table of the components they touch. A
+//! component that no run of the current row continues is complete; it is compared
+//! with the best so far and its table entry is freed. Memory is therefore bounded by
+//! the number of runs a row can hold (164 on a 328-pixel row), not by the frame.
+
+use super::{BoxRule, Roi};
+use crate::frame::FRAME_WIDTH;
+
+/// Most runs a row of [`FRAME_WIDTH`] pixels can hold (foreground, gap, foreground, ...).
+const MAX_RUNS: usize = FRAME_WIDTH.div_ceil(2);
+/// Components alive at once: those of the previous row plus new ones of this row.
+const MAX_COMPONENTS: usize = 2 * MAX_RUNS;
+/// Marks a free component-table entry.
+const FREE: u16 = u16::MAX;
+
+/// A horizontal run of foreground pixels `[x0, x1)` and its component label.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    x0: u16,
+    x1: u16,
+    label: u16,
+}
+
+const NO_RUN: Run = Run {
+    x0: 0,
+    x1: 0,
+    label: FREE,
+};
+
+/// Statistics of one (partial) component.
+#[derive(Debug, Clone, Copy)]
+struct Component {
+    /// Union-find parent; itself for a root, [`FREE`] for an unused entry.
+    parent: u16,
+    /// Last row in which a run of this component was seen.
+    seen_row: u16,
+    /// Bounding box so far.
+    roi: Roi,
+    /// Pixels so far.
+    area: u32,
+    /// Raster index `y·width + x` of the first pixel (the tie-breaker).
+    first: u32,
+}
+
+const FREE_COMPONENT: Component = Component {
+    parent: FREE,
+    seen_row: 0,
+    roi: Roi::EMPTY,
+    area: 0,
+    first: u32::MAX,
+};
+
+impl Component {
+    /// True when `self` beats `other` as the largest component.
+    fn beats(&self, other: &Component) -> bool {
+        self.area > other.area || (self.area == other.area && self.first < other.first)
+    }
+
+    fn merge(&mut self, other: &Component) {
+        self.roi = self.roi.hull(&other.roi);
+        self.area += other.area;
+        self.first = self.first.min(other.first);
+    }
+}
+
+/// Turns a foreground mask, pushed one row at a time, into a box and a pixel count.
+///
+/// Memory: about 8.5 KiB, fixed; part of every detector's [`super::Scratch`].
+#[derive(Debug, Clone)]
+pub struct RoiBuilder {
+    rule: BoxRule,
+    width: usize,
+    /// Row expected next; rows must come in order.
+    next_row: usize,
+    foreground_px: u32,
+    /// [`BoxRule::AllForeground`]: the hull of all foreground pixels.
+    hull: Roi,
+    prev: [Run; MAX_RUNS],
+    prev_len: usize,
+    cur: [Run; MAX_RUNS],
+    cur_len: usize,
+    table: [Component; MAX_COMPONENTS],
+    /// One past the highest table entry in use.
+    table_high: usize,
+    best: Component,
+}
+
+impl Default for RoiBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RoiBuilder {
+    /// An idle builder (call [`RoiBuilder::start`] before pushing rows).
+    pub const fn new() -> Self {
+        RoiBuilder {
+            rule: BoxRule::AllForeground,
+            width: 0,
+            next_row: 0,
+            foreground_px: 0,
+            hull: Roi::EMPTY,
+            prev: [NO_RUN; MAX_RUNS],
+            prev_len: 0,
+            cur: [NO_RUN; MAX_RUNS],
+            cur_len: 0,
+            table: [FREE_COMPONENT; MAX_COMPONENTS],
+            table_high: 0,
+            best: FREE_COMPONENT,
+        }
+    }
+
+    /// Starts a frame `width` pixels wide (at most [`FRAME_WIDTH`]; wider rows are cut).
+    pub fn start(&mut self, rule: BoxRule, width: usize) {
+        self.rule = rule;
+        self.width = width.min(FRAME_WIDTH);
+        self.next_row = 0;
+        self.foreground_px = 0;
+        self.hull = Roi::EMPTY;
+        self.prev_len = 0;
+        self.cur_len = 0;
+        for c in &mut self.table[..self.table_high] {
+            *c = FREE_COMPONENT;
+        }
+        self.table_high = 0;
+        self.best = FREE_COMPONENT;
+    }
+
+    /// Adds mask row `y` (`true` = foreground). Rows must come in order 0, 1, 2, ...;
+    /// a skipped row counts as background, a repeated or earlier row is ignored.
+    pub fn push_row(&mut self, y: usize, mask: &[bool]) {
+        if y < self.next_row || y >= usize::from(u16::MAX) {
+            return;
+        }
+        while self.next_row < y {
+            self.close_row(self.next_row, 0, &[]);
+        }
+        let mask = &mask[..mask.len().min(self.width)];
+        // Written so the count vectorises; first/last stop at the first hit.
+        let count = mask.iter().map(|&m| u32::from(m)).sum::<u32>();
+        self.foreground_px += count;
+        let (Some(first), Some(last)) =
+            (mask.iter().position(|&m| m), mask.iter().rposition(|&m| m))
+        else {
+            self.close_row(y, 0, &[]);
+            return;
+        };
+        match self.rule {
+            BoxRule::AllForeground => {
+                let row = Roi::new(first as u16, y as u16, last as u16 + 1, y as u16 + 1);
+                self.hull = self.hull.hull(&row);
+                self.next_row = y + 1;
+            }
+            BoxRule::LargestComponent => self.close_row(y, first, &mask[first..=last]),
+        }
+    }
+
+    /// Finishes the frame: the box (if any foreground) and the foreground pixel count.
+    pub fn finish(&mut self) -> (Option<Roi>, u32) {
+        let roi = match self.rule {
+            BoxRule::AllForeground => self.hull,
+            BoxRule::LargestComponent => {
+                // Everything still open is complete.
+                let y = self.next_row;
+                self.close_row(y, 0, &[]);
+                self.best.roi
+            }
+        };
+        (
+            if roi.is_empty() { None } else { Some(roi) },
+            self.foreground_px,
+        )
+    }
+
+    /// Labels the runs of row `y` (`mask` holds pixels `x0..x0 + mask.len()`; empty for
+    /// a background row) and retires the components the row does not continue.
+    fn close_row(&mut self, y: usize, x0: usize, mask: &[bool]) {
+        self.next_row = y + 1;
+        if self.rule != BoxRule::LargestComponent || (mask.is_empty() && self.prev_len == 0) {
+            return;
+        }
+        self.collect_runs(x0, mask);
+        self.link_runs(y);
+        self.retire(y);
+        core::mem::swap(&mut self.prev, &mut self.cur);
+        self.prev_len = self.cur_len;
+        self.cur_len = 0;
+    }
+
+    /// Splits the mask row into runs (at most [`MAX_RUNS`] fit any row of the width).
+    fn collect_runs(&mut self, x0: usize, mask: &[bool]) {
+        self.cur_len = 0;
+        let mut x = 0;
+        while x < mask.len() {
+            if !mask[x] {
+                x += 1;
+                continue;
+            }
+            let start = x;
+            while x < mask.len() && mask[x] {
+                x += 1;
+            }
+            if let Some(run) = self.cur.get_mut(self.cur_len) {
+                *run = Run {
+                    x0: (x0 + start) as u16,
+                    x1: (x0 + x) as u16,
+                    label: FREE,
+                };
+                self.cur_len += 1;
+            }
+        }
+    }
+
+    /// Gives every run of the current row a component: the union of the components of
+    /// the 8-connected runs above it, or a new one.
+    fn link_runs(&mut self, y: usize) {
+        let mut j0 = 0;
+        for i in 0..self.cur_len {
+            let run = self.cur[i];
+            // Runs above that end left of this run's left neighbour can no longer touch
+            // this or any later run.
+            while j0 < self.prev_len && self.prev[j0].x1 < run.x0 {
+                j0 += 1;
+            }
+            let mut label = FREE;
+            let mut j = j0;
+            while j < self.prev_len && self.prev[j].x0 <= run.x1 {
+                let root = self.find(self.prev[j].label);
+                label = if label == FREE {
+                    root
+                } else {
+                    self.union(label, root)
+                };
+                j += 1;
+            }
+            if label == FREE {
+                match self.alloc() {
+                    Some(l) => label = l,
+                    // Unreachable by the capacity argument (at most MAX_RUNS components
+                    // survive a row, at most MAX_RUNS are born in one); drop the run
+                    // rather than panic.
+                    None => continue,
+                }
+            }
+            let width = self.width as u32;
+            let c = &mut self.table[usize::from(label)];
+            let run_roi = Roi::new(run.x0, y as u16, run.x1, y as u16 + 1);
+            c.roi = c.roi.hull(&run_roi);
+            c.area += u32::from(run.x1 - run.x0);
+            c.first = c.first.min(y as u32 * width + u32::from(run.x0));
+            self.cur[i].label = label;
+        }
+    }
+
+    /// Points every current run at its root, then frees every entry that is not the
+    /// root of a current run; roots no current run reaches are complete components.
+    fn retire(&mut self, y: usize) {
+        let stamp = y as u16;
+        for i in 0..self.cur_len {
+            let root = self.find(self.cur[i].label);
+            self.cur[i].label = root;
+            if let Some(c) = self.table.get_mut(usize::from(root)) {
+                c.seen_row = stamp;
+            }
+        }
+        let mut high = 0;
+        for k in 0..self.table_high {
+            let c = self.table[k];
+            if c.parent == FREE {
+                continue;
+            }
+            let is_root = usize::from(c.parent) == k;
+            if is_root && c.seen_row == stamp && c.area > 0 {
+                high = k + 1;
+                continue;
+            }
+            if is_root && c.beats(&self.best) {
+                self.best = c;
+            }
+            self.table[k] = FREE_COMPONENT;
+        }
+        self.table_high = high;
+    }
+
+    /// A free table entry, as a new root with no pixels yet.
+    fn alloc(&mut self) -> Option<u16> {
+        let k = self.table.iter().position(|c| c.parent == FREE)?;
+        self.table[k] = Component {
+            parent: k as u16,
+            ..FREE_COMPONENT
+        };
+        self.table[k].area = 0;
+        self.table_high = self.table_high.max(k + 1);
+        Some(k as u16)
+    }
+
+    /// The root of `label`, halving the path on the way.
+    fn find(&mut self, mut label: u16) -> u16 {
+        loop {
+            let parent = self.table[usize::from(label)].parent;
+            if parent == label || parent == FREE {
+                return label;
+            }
+            let grand = self.table[usize::from(parent)].parent;
+            self.table[usize::from(label)].parent = grand;
+            label = parent;
+        }
+    }
+
+    /// Joins two roots; the lower index stays root and takes the other's statistics.
+    fn union(&mut self, a: u16, b: u16) -> u16 {
+        if a == b {
+            return a;
+        }
+        let (keep, gone) = if a < b { (a, b) } else { (b, a) };
+        let gone_c = self.table[usize::from(gone)];
+        self.table[usize::from(keep)].merge(&gone_c);
+        self.table[usize::from(gone)].parent = keep;
+        keep
+    }
+}

@@ -1,0 +1,393 @@
+//! Otsu's global threshold (Otsu 1979, paper ref. [47]), exact on the full bit depth.
+//!
+//! The threshold `t` splits the DN into a background class `v ≤ t` and a foreground
+//! class `v > t`; Otsu's choice maximises the between-class variance
+//! `σ_B²(t) ∝ (M·n₀ − N·m₀)² / (n₀·(N − n₀))` (N pixels summing to M; n₀ pixels
+//! summing to m₀ in the background class).
+//!
+//! A full 2^14-bin histogram would take 64 KiB. Instead the detector histograms the
+//! frame into [`COARSE_BINS`] bins (count and sum of each), evaluates σ_B² exactly at
+//! every bin boundary, and bounds it from above inside every bin (branch and bound).
+//! Only bins whose bound reaches the best boundary value are histogrammed at full
+//! resolution in further passes, [`FINE_SLOTS`] DN at a time. All arithmetic is exact
+//! integer arithmetic, so the result equals an exhaustive search over every threshold
+//! `0..max_dn`, ties going to the smallest threshold. Typical frames need one or two
+//! extra passes.
+//!
+//! The reported [`Detection::threshold`](super::Detection::threshold) is that smallest
+//! maximising `t`, i.e. the brightest DN present in the background class. A frame
+//! with a single DN value has no split: its threshold is that DN and no pixel is
+//! foreground.
+
+use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use crate::frame::{FRAME_WIDTH, Frame};
+
+/// Coarse histogram bins (a bin spans `2^(bits − 8)` DN for bit depths above 8).
+pub const COARSE_BINS: usize = 256;
+const COARSE_SHIFT_BITS: u8 = 8;
+/// Full-resolution counters for the refinement passes (DN values per pass).
+pub const FINE_SLOTS: usize = 512;
+/// Marks a coarse bin that is not refined in the current pass.
+const NOT_REFINED: u8 = u8::MAX;
+
+/// Parameters of the Otsu detector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Otsu {
+    /// Mask-to-box rule (default [`BoxRule::AllForeground`]).
+    pub box_rule: BoxRule,
+}
+
+/// Otsu's buffers: the coarse histogram, the refinement counters and a mask row.
+#[derive(Debug, Clone)]
+pub struct OtsuWork {
+    /// Per coarse bin: pixel count in the high 32 bits, sum of `v − bin_start` in the
+    /// low 32 (≤ 2^8 · 81 344 < 2^32), so the histogram pass does one add per pixel.
+    /// Two interleaved copies (even and odd pixels) halve the store-to-load chains
+    /// that runs of equal bins cause.
+    coarse: [[u64; COARSE_BINS]; 2],
+    /// Pixels per DN of the bins being refined.
+    fine: [u32; FINE_SLOTS],
+    /// Position of each coarse bin in `fine` (in bins), or [`NOT_REFINED`].
+    slot: [u8; COARSE_BINS],
+    mask: [bool; FRAME_WIDTH],
+}
+
+/// The Otsu detector's scratch memory.
+pub type OtsuScratch = Scratch<OtsuWork>;
+
+/// Bytes of [`OtsuScratch`] (budget: 16 KiB).
+pub const SCRATCH_BYTES: usize = core::mem::size_of::<OtsuScratch>();
+
+impl OtsuScratch {
+    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
+    pub const fn new() -> Self {
+        Scratch {
+            work: OtsuWork {
+                coarse: [[0; COARSE_BINS]; 2],
+                fine: [0; FINE_SLOTS],
+                slot: [NOT_REFINED; COARSE_BINS],
+                mask: [false; FRAME_WIDTH],
+            },
+            roi: RoiBuilder::new(),
+        }
+    }
+}
+
+impl Default for OtsuScratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// An exact value of the between-class variance, up to the common factor 1/N⁴:
+/// `d² / den` with `d = M·n₀ − N·m₀` and `den = n₀·(N − n₀)`.
+#[derive(Debug, Clone, Copy)]
+struct Score {
+    d2: u128,
+    den: u128,
+}
+
+impl Score {
+    const ZERO: Score = Score { d2: 0, den: 1 };
+
+    fn of(d: i128, den: u128) -> Score {
+        Score {
+            d2: d.unsigned_abs() * d.unsigned_abs(),
+            den,
+        }
+    }
+
+    /// Exact comparison of `d2/den` with `other.d2/other.den` without overflow:
+    /// compare the integer quotients, then the remainders cross-multiplied
+    /// (each remainder is below its denominator ≤ 2^32).
+    fn cmp(&self, other: &Score) -> core::cmp::Ordering {
+        // Fast path: the f64 ratios differ by far more than their rounding error.
+        let a = self.d2 as f64 / self.den as f64;
+        let b = other.d2 as f64 / other.den as f64;
+        if a > b * (1.0 + 1e-9) {
+            return core::cmp::Ordering::Greater;
+        }
+        if a < b * (1.0 - 1e-9) {
+            return core::cmp::Ordering::Less;
+        }
+        let (q1, r1) = (self.d2 / self.den, self.d2 % self.den);
+        let (q2, r2) = (other.d2 / other.den, other.d2 % other.den);
+        q1.cmp(&q2).then((r1 * other.den).cmp(&(r2 * self.den)))
+    }
+}
+
+/// The best split so far: its score and its background-class size (tie-breaker: a
+/// smaller background class means a smaller threshold).
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    score: Score,
+    n0: u64,
+    /// A threshold realising the split (the largest DN of its bin or slot).
+    t: u16,
+}
+
+impl Best {
+    fn offer(&mut self, score: Score, n0: u64, t: u16) {
+        let better = match score.cmp(&self.score) {
+            core::cmp::Ordering::Greater => true,
+            core::cmp::Ordering::Equal => n0 < self.n0,
+            core::cmp::Ordering::Less => false,
+        };
+        if better {
+            *self = Best { score, n0, t };
+        }
+    }
+}
+
+/// Totals of the frame used by every score.
+struct Totals {
+    n: u64,
+    m: u64,
+}
+
+impl Totals {
+    /// Score of the split with `n0` pixels summing to `m0` in the background, or
+    /// `None` when a class is empty.
+    fn score(&self, n0: u64, m0: u64) -> Option<Score> {
+        if n0 == 0 || n0 >= self.n {
+            return None;
+        }
+        let d = i128::from(self.m) * i128::from(n0) - i128::from(self.n) * i128::from(m0);
+        Some(Score::of(d, u128::from(n0) * u128::from(self.n - n0)))
+    }
+}
+
+/// Histogram, boundary scores, branch and bound: a threshold realising the exact
+/// optimum (the mask pass later maps it to the smallest such threshold).
+fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
+    let max_dn = frame.max_dn();
+    let shift = frame.bits().saturating_sub(COARSE_SHIFT_BITS);
+    let bin_width = 1usize << shift;
+    let bins = (usize::from(max_dn) >> shift) + 1;
+    let low_mask = (bin_width - 1) as u16;
+
+    let [even, odd] = &mut work.coarse;
+    even.fill(0);
+    odd.fill(0);
+    // `& (COARSE_BINS − 1)` never changes an index (v >> shift < 256); it lets the
+    // compiler drop the bounds check.
+    let entry = |v: u16| {
+        let v = v.min(max_dn);
+        (
+            usize::from(v >> shift) & (COARSE_BINS - 1),
+            (1 << 32) | u64::from(v & low_mask),
+        )
+    };
+    let mut pairs = frame.pixels().chunks_exact(2);
+    for pair in &mut pairs {
+        let (a, ea) = entry(pair[0]);
+        let (b, eb) = entry(pair[1]);
+        even[a] += ea;
+        odd[b] += eb;
+    }
+    for &v in pairs.remainder() {
+        let (a, ea) = entry(v);
+        even[a] += ea;
+    }
+    for (e, &o) in even.iter_mut().zip(odd.iter()) {
+        *e += o;
+    }
+    let coarse = &*even;
+    let count = |b: usize| coarse[b] >> 32;
+    let sum = |b: usize| count(b) * ((b as u64) << shift) + (coarse[b] & 0xFFFF_FFFF);
+    let totals = Totals {
+        n: frame.pixels().len() as u64,
+        m: (0..bins).map(sum).sum(),
+    };
+
+    // Exact scores at the bin boundaries (threshold = last DN of bin b).
+    let mut best = Best {
+        score: Score::ZERO,
+        n0: u64::MAX,
+        t: max_dn,
+    };
+    let (mut n0, mut m0) = (0u64, 0u64);
+    for b in 0..bins {
+        n0 += count(b);
+        m0 += sum(b);
+        if let Some(s) = totals.score(n0, m0) {
+            best.offer(s, n0, (((b + 1) << shift) - 1) as u16);
+        }
+    }
+    if best.n0 == u64::MAX || bin_width == 1 {
+        // No split (a single DN value: all background), or already at full resolution.
+        return best.t;
+    }
+
+    // Branch and bound: histogram at full resolution, a few bins per pass, the bins
+    // whose bound reaches the best score so far (in order; later passes prune more).
+    let bins_per_pass = (FINE_SLOTS / bin_width).clamp(1, usize::from(NOT_REFINED));
+    let mut next_bin = 0;
+    loop {
+        let slot = &mut work.slot;
+        slot.fill(NOT_REFINED);
+        let mut picked = 0u8;
+        let (mut n_a, mut m_a) = (0u64, 0u64);
+        for b in 0..bins {
+            let (n_b, m_b) = (n_a + count(b), m_a + sum(b));
+            if b >= next_bin
+                && usize::from(picked) < bins_per_pass
+                && count(b) > 1
+                && bin_may_beat(&totals, &best, b, shift, (n_a, m_a), (n_b, m_b))
+            {
+                slot[b] = picked;
+                picked += 1;
+                next_bin = b + 1;
+            }
+            (n_a, m_a) = (n_b, m_b);
+        }
+        if picked == 0 {
+            return best.t;
+        }
+        let fine = &mut work.fine;
+        fine[..usize::from(picked) * bin_width].fill(0);
+        for &v in frame.pixels() {
+            let v = v.min(max_dn);
+            let s = slot[usize::from(v >> shift) & (COARSE_BINS - 1)];
+            if s != NOT_REFINED {
+                fine[(usize::from(s) * bin_width + usize::from(v & low_mask))
+                    & (FINE_SLOTS - 1)] += 1;
+            }
+        }
+        // Exact scores at every DN of the picked bins.
+        let (mut n0, mut m0) = (0u64, 0u64);
+        for b in 0..bins {
+            let s = slot[b];
+            if s != NOT_REFINED {
+                let (mut n, mut m) = (n0, m0);
+                let base = usize::from(s) * bin_width;
+                for (k, &c) in fine[base..base + bin_width - 1].iter().enumerate() {
+                    let v = ((b as u64) << shift) + k as u64;
+                    n += u64::from(c);
+                    m += u64::from(c) * v;
+                    if let Some(sc) = totals.score(n, m) {
+                        best.offer(sc, n, v as u16);
+                    }
+                }
+            }
+            n0 += count(b);
+            m0 += sum(b);
+        }
+        if usize::from(picked) < bins_per_pass {
+            // Every remaining candidate was in this pass.
+            return best.t;
+        }
+    }
+}
+
+/// Upper bound of σ_B² over the thresholds strictly inside bin `b` (DN
+/// `lo..lo + width − 1`), compared with `best`: true when the bin could hold a split
+/// at least as good. `(n_a, m_a)` and `(n_b, m_b)` are the background class before
+/// and after the bin.
+///
+/// Inside the bin, `d(t) = M·n₀ − N·m₀` moves from `d_a` to `d_b` by `n_v·(M − N·v)`
+/// per DN `v`. When the bin lies on one side of the mean `M/N` those steps share a
+/// sign, so `|d| ≤ max(|d_a|, |d_b|)`; otherwise `|d| ≤ |d_a| + count·max_v |M − N·v|`.
+/// `n₀(N − n₀)` is concave in `n₀`, so its minimum over `[n_a, n_b]` is at an end.
+fn bin_may_beat(
+    totals: &Totals,
+    best: &Best,
+    b: usize,
+    shift: u8,
+    (n_a, m_a): (u64, u64),
+    (n_b, m_b): (u64, u64),
+) -> bool {
+    let (n, m) = (i128::from(totals.n), i128::from(totals.m));
+    let lo = (b as i128) << shift;
+    let hi = lo + (1i128 << shift) - 1;
+    let d_a = m * i128::from(n_a) - n * i128::from(m_a);
+    let d_b = m * i128::from(n_b) - n * i128::from(m_b);
+    let (step_lo, step_hi) = (m - n * lo, m - n * hi);
+    let d_max = if (step_lo >= 0) == (step_hi >= 0) {
+        d_a.unsigned_abs().max(d_b.unsigned_abs())
+    } else {
+        let count = u128::from(n_b - n_a);
+        d_a.unsigned_abs() + count * step_lo.unsigned_abs().max(step_hi.unsigned_abs())
+    };
+    let n_lo = n_a.max(1);
+    let n_hi = n_b.min(totals.n - 1);
+    if n_lo > n_hi {
+        return false;
+    }
+    let den = |k: u64| u128::from(k) * u128::from(totals.n - k);
+    let bound = Score {
+        d2: d_max * d_max,
+        den: den(n_lo).min(den(n_hi)),
+    };
+    bound.cmp(&best.score) != core::cmp::Ordering::Less
+}
+
+impl Detector for Otsu {
+    type Work = OtsuWork;
+    const NAME: &'static str = "otsu";
+
+    fn validate(&self) -> Result<(), DetectError> {
+        Ok(())
+    }
+
+    fn box_rule(&self) -> BoxRule {
+        self.box_rule
+    }
+
+    /// Foreground: `DN > t`. Threshold: the smallest `t` maximising the between-class
+    /// variance, in DN.
+    fn foreground<F: FnMut(usize, &[bool])>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut OtsuWork,
+        mut sink: F,
+    ) -> u32 {
+        let t = otsu_split(frame, work);
+        let max_dn = frame.max_dn();
+        // The split is the same for every t between the brightest background DN and
+        // the darkest foreground DN; report the smallest, as an exhaustive search would.
+        let mut brightest_background = 0u16;
+        let mask = &mut work.mask[..frame.width()];
+        for (y, row) in frame.rows().enumerate() {
+            for (m, &v) in mask.iter_mut().zip(row) {
+                let v = v.min(max_dn);
+                let fg = v > t;
+                *m = fg;
+                brightest_background = brightest_background.max(if fg { 0 } else { v });
+            }
+            sink(y, mask);
+        }
+        u32::from(brightest_background)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::roi::Roi;
+
+    #[test]
+    fn score_comparison_is_exact_near_ties() {
+        let a = Score { d2: 10, den: 3 };
+        let b = Score { d2: 20, den: 6 };
+        assert_eq!(a.cmp(&b), core::cmp::Ordering::Equal);
+        let c = Score { d2: 21, den: 6 };
+        assert_eq!(a.cmp(&c), core::cmp::Ordering::Less);
+    }
+
+    #[test]
+    fn roi_of_bright_square() {
+        let mut px = [100u16; 16 * 12];
+        for y in 3..7 {
+            for x in 5..9 {
+                px[y * 16 + x] = 9000;
+            }
+        }
+        let f = Frame::new(&px, 16, 12, 14).unwrap();
+        let mut s = OtsuScratch::new();
+        let d = Otsu::default().detect(&f, &mut s).unwrap();
+        assert_eq!(d.roi, Some(Roi::new(5, 3, 9, 7)));
+        assert_eq!(d.threshold, 100);
+        assert_eq!(d.foreground_px, 16);
+    }
+}

@@ -1,0 +1,245 @@
+//! The `tirroi` command line.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use serde::Serialize;
+use tirroi_core::Method;
+
+use crate::fixture;
+use crate::image_io::read_frame;
+use crate::run::DetectorBank;
+
+/// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+/// tirroi: synthetic thermal-infrared frames and flight-ready ROI detection.
+#[derive(Debug, Parser)]
+#[command(name = "tirroi", version, about)]
+pub struct Cli {
+    /// What to do (default: `demo`).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Detect the ROI in 8/16-bit grayscale PNG (or TIFF) frames.
+    Detect {
+        /// Detector: otsu, adaptive, wge, dog, or all.
+        #[arg(long, default_value = "all", value_parser = parse_methods)]
+        method: MethodChoice,
+        /// Runs per frame and method; the reported time is the median.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        repeat: u32,
+        /// Print one JSON object per frame and method.
+        #[arg(long)]
+        json: bool,
+        /// Bit depth of the DN (default: 8 for 8-bit files; 14 for 16-bit files whose
+        /// DN fit, else 16).
+        #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
+        bits: Option<u8>,
+        /// Frames to process.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Print the scratch memory of each detector, in bytes.
+    Memory,
+    /// Write the procedural fixture frames as 16-bit PNG with a `truth.csv`.
+    Fixtures {
+        /// Output directory (created if missing).
+        #[arg(long, default_value = "fixtures")]
+        out: PathBuf,
+    },
+    /// Run every detector on the built-in procedural frames and print IoU and time.
+    Demo {
+        /// Runs per frame and method; the reported time is the median.
+        #[arg(long, default_value_t = 21)]
+        repeat: u32,
+    },
+}
+
+/// One method or all of them.
+#[derive(Debug, Clone)]
+pub struct MethodChoice(pub Vec<Method>);
+
+fn parse_methods(s: &str) -> Result<MethodChoice, String> {
+    if s == "all" {
+        return Ok(MethodChoice(Method::ALL.to_vec()));
+    }
+    Method::from_name(s)
+        .map(|m| MethodChoice(vec![m]))
+        .ok_or_else(|| format!("unknown method `{s}`; expected otsu, adaptive, wge, dog or all"))
+}
+
+/// The JSON line of `tirroi detect --json` (DESIGN.md).
+#[derive(Debug, Serialize)]
+struct DetectLine<'a> {
+    file: &'a str,
+    method: &'static str,
+    bbox: Option<[u16; 4]>,
+    time_us: f64,
+}
+
+/// Runs the command line; returns the process exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command.unwrap_or(Command::Demo { repeat: 21 }) {
+        Command::Detect {
+            method,
+            repeat,
+            json,
+            bits,
+            files,
+        } => detect(&method.0, repeat as usize, json, bits, &files),
+        Command::Memory => {
+            println!("| detector | scratch bytes |");
+            println!("|---|---|");
+            for m in Method::ALL {
+                println!("| {m} | {} |", m.scratch_bytes());
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Demo { repeat } => demo(repeat as usize),
+        Command::Fixtures { out } => match write_fixtures(&out) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("tirroi: error: {e}");
+                ExitCode::from(EXIT_BAD_INPUT)
+            }
+        },
+    }
+}
+
+fn detect(
+    methods: &[Method],
+    repeat: usize,
+    json: bool,
+    bits: Option<u8>,
+    files: &[PathBuf],
+) -> ExitCode {
+    let mut bank = DetectorBank::default();
+    let mut failed = false;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for path in files {
+        let frame = match read_frame(path, bits) {
+            Ok(f) => f,
+            Err(e) => {
+                eprintln!("tirroi: error: {e}");
+                failed = true;
+                continue;
+            }
+        };
+        let view = match frame.view() {
+            Ok(v) => v,
+            Err(e) => {
+                eprintln!("tirroi: error: {}: {e}", path.display());
+                failed = true;
+                continue;
+            }
+        };
+        for &method in methods {
+            let (d, time_us) = match bank.detect_timed(method, &view, repeat) {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("tirroi: error: {method}: {e}");
+                    return ExitCode::from(EXIT_BAD_INPUT);
+                }
+            };
+            let file = path.to_string_lossy();
+            let written = if json {
+                let line = DetectLine {
+                    file: &file,
+                    method: method.name(),
+                    bbox: d.roi.map(|r| r.to_array()),
+                    time_us: (time_us * 1000.0).round() / 1000.0,
+                };
+                serde_json::to_string(&line)
+                    .map_err(std::io::Error::other)
+                    .and_then(|s| writeln!(out, "{s}"))
+            } else {
+                let bbox = d
+                    .roi
+                    .map(|r| format!("{:?}", r.to_array()))
+                    .unwrap_or_else(|| "none".into());
+                writeln!(
+                    out,
+                    "{file}  {:<8}  bbox {bbox:<22}  {time_us:>9.1} us  threshold {}  foreground {} px",
+                    method.name(),
+                    d.threshold,
+                    d.foreground_px
+                )
+            };
+            if written.is_err() {
+                // Output closed (e.g. piped into `head`): stop quietly.
+                return ExitCode::SUCCESS;
+            }
+        }
+    }
+    if failed {
+        ExitCode::from(EXIT_BAD_INPUT)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn demo(repeat: usize) -> ExitCode {
+    println!("tirroi demo: the four detectors on procedural 328x248 14-bit frames");
+    println!(
+        "(not physically rendered: the renderer and the paper's tables come with later work)\n"
+    );
+    let mut bank = DetectorBank::default();
+    println!("| frame | method | bbox | truth | IoU | median time [us] |");
+    println!("|---|---|---|---|---|---|");
+    for (name, spec) in fixture::standard_set() {
+        let fx = fixture::render(&spec);
+        let Ok(view) = fx.frame.view() else {
+            eprintln!("tirroi: error: fixture {name} does not fit the core");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        };
+        for method in Method::ALL {
+            match bank.detect_timed(method, &view, repeat) {
+                Ok((d, t)) => {
+                    let iou = d.roi.map_or(0.0, |r| r.iou(&fx.truth));
+                    let bbox = d
+                        .roi
+                        .map_or("none".into(), |r| format!("{:?}", r.to_array()));
+                    println!(
+                        "| {name} | {method} | {bbox} | {:?} | {iou:.3} | {t:.1} |",
+                        fx.truth.to_array()
+                    );
+                }
+                Err(e) => {
+                    eprintln!("tirroi: error: {method}: {e}");
+                    return ExitCode::from(EXIT_BAD_INPUT);
+                }
+            }
+        }
+    }
+    println!("\nScratch memory per detector: `tirroi memory`.");
+    ExitCode::SUCCESS
+}
+
+fn write_fixtures(out: &std::path::Path) -> Result<(), String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: cannot create: {e}", out.display()))?;
+    let mut csv = String::from("file,x0,y0,x1,y1\n");
+    for (name, spec) in fixture::standard_set() {
+        let fx = fixture::render(&spec);
+        let file = format!("{name}.png");
+        crate::image_io::write_png16(&out.join(&file), &fx.frame).map_err(|e| e.to_string())?;
+        let [x0, y0, x1, y1] = fx.truth.to_array();
+        csv.push_str(&format!("{file},{x0},{y0},{x1},{y1}\n"));
+    }
+    let truth = out.join("truth.csv");
+    std::fs::write(&truth, csv).map_err(|e| format!("{}: cannot write: {e}", truth.display()))?;
+    println!(
+        "wrote {} frames and truth.csv to {}",
+        fixture::standard_set().len(),
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,11 @@
+//! # tirroi-host
+//!
+//! The host harness of tirroi: it drives the flight core (`tirroi-core`) exactly as
+//! flight would, from PNG frames or procedural fixtures, and hosts the `tirroi` CLI.
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod cli;
+pub mod fixture;
+pub mod image_io;
+pub mod run;
