@@ -34,6 +34,10 @@ pub const MAX_LEVELS: u8 = 8;
 pub const MAX_RADIUS: usize = 64;
 /// Most blobs kept per frame (the strongest).
 pub const MAX_BLOBS: usize = 64;
+/// Lanes of the blur's dot product (taps are padded to a multiple).
+const LANES: usize = 8;
+/// Kernel taps with padding.
+const KERNEL_CAPACITY: usize = (2 * MAX_RADIUS + 1).next_multiple_of(LANES);
 /// Fixed-point scale of the kernel weights (Q15).
 const ONE_Q15: u32 = 1 << 15;
 /// Fixed-point scale of the scale normalisation σ_i/σ_0 (Q4).
@@ -95,7 +99,8 @@ pub struct DogWork {
     tmp: [u16; PLANE],
     ring: [[u16; PLANE]; 4],
     row_sum: [u32; PLANE_WIDTH],
-    kernel: [u32; 2 * MAX_RADIUS + 1],
+    pad: [i16; PLANE_WIDTH + KERNEL_CAPACITY],
+    kernel: [i16; 2 * MAX_RADIUS + 1],
     blobs: [Blob; MAX_BLOBS],
     blob_count: usize,
     mask: [bool; FRAME_WIDTH],
@@ -116,6 +121,7 @@ impl DogScratch {
                 tmp: [0; PLANE],
                 ring: [[0; PLANE]; 4],
                 row_sum: [0; PLANE_WIDTH],
+                pad: [0; PLANE_WIDTH + KERNEL_CAPACITY],
                 kernel: [0; 2 * MAX_RADIUS + 1],
                 blobs: [NO_BLOB; MAX_BLOBS],
                 blob_count: 0,
@@ -158,8 +164,8 @@ impl Dog {
 }
 
 /// Fills `kernel[..2r+1]` with Q15 Gaussian weights of σ `sigma` (plane pixels) that
-/// sum exactly to 2^15; returns r.
-fn gaussian_kernel(sigma: f32, r: usize, kernel: &mut [u32]) -> usize {
+/// sum exactly to 2^15 (each below 2^15 for σ ≥ 0.25); returns r.
+fn gaussian_kernel(sigma: f32, r: usize, kernel: &mut [i16]) -> usize {
     let r = r.min(MAX_RADIUS);
     let taps = &mut kernel[..2 * r + 1];
     let mut total = 0.0f32;
@@ -169,43 +175,53 @@ fn gaussian_kernel(sigma: f32, r: usize, kernel: &mut [u32]) -> usize {
         *g = libm::expf(-0.5 * d * d / (sigma * sigma));
         total += *g;
     }
-    let mut sum = 0u32;
+    let mut sum = 0i32;
     for (t, &g) in taps.iter_mut().zip(&raw[..2 * r + 1]) {
-        *t = libm::roundf(g / total * ONE_Q15 as f32) as u32;
-        sum += *t;
+        *t = libm::roundf(g / total * ONE_Q15 as f32) as i16;
+        sum += i32::from(*t);
     }
     // The centre tap takes the rounding remainder (it is the largest weight).
-    taps[r] = (taps[r] + ONE_Q15).saturating_sub(sum);
+    taps[r] = (i32::from(taps[r]) + ONE_Q15 as i32 - sum).clamp(0, i32::from(i16::MAX)) as i16;
     r
 }
 
-/// One separable blur pass along lines of `len` samples `stride` apart: `dst = k ∗ src`
-/// with replicated borders, rounded to the nearest integer.
-fn blur_lines(
-    src: &[u16],
-    dst: &mut [u16],
-    lines: usize,
-    len: usize,
-    line_step: usize,
-    stride: usize,
-    kernel: &[u32],
-) {
+/// Blurs every row of the `w`-wide plane `src` with `kernel` (replicated borders,
+/// rounded to the nearest integer) and writes the result transposed into `dst`
+/// (`dst[x·h + y]`). Two calls make a separable 2-D blur, and both run their dot
+/// products along contiguous memory.
+///
+/// The dot products are i16 × i16 → i32 (x86 `pmaddwd`, Arm `SMLAD`): samples are
+/// stored offset by −2^15 in `pad` (one row with its borders), and because the Q15
+/// weights sum to exactly 2^15 the offset comes back as the constant 2^30.
+fn blur_rows_transposed(src: &[u16], dst: &mut [u16], w: usize, kernel: &[i16], pad: &mut [i16]) {
     let r = kernel.len() / 2;
-    for line in 0..lines {
-        let at = |i: usize| line * line_step + i * stride;
-        for i in 0..len {
-            let mut acc = ONE_Q15 / 2;
-            if i >= r && i + r < len {
-                for (k, &w) in kernel.iter().enumerate() {
-                    acc += w * u32::from(src[at(i + k - r)]);
-                }
-            } else {
-                for (k, &w) in kernel.iter().enumerate() {
-                    let j = (i + k).saturating_sub(r).min(len - 1);
-                    acc += w * u32::from(src[at(j)]);
+    let h = src.len() / w;
+    // Taps padded with zero weights to a multiple of 8, so the dot product is whole
+    // 8-lane blocks.
+    let taps = kernel.len().next_multiple_of(LANES);
+    let mut weights = [0i16; KERNEL_CAPACITY];
+    weights[..kernel.len()].copy_from_slice(kernel);
+    let weights = &weights[..taps];
+    let pad = &mut pad[..w + taps - 1];
+    let centred = |v: u16| (v ^ 0x8000) as i16;
+    for (y, row) in src.chunks_exact(w).enumerate() {
+        let (left, rest) = pad.split_at_mut(r);
+        let (middle, right) = rest.split_at_mut(w);
+        left.fill(centred(row[0]));
+        for (m, &v) in middle.iter_mut().zip(row) {
+            *m = centred(v);
+        }
+        right.fill(centred(row[w - 1]));
+        for x in 0..w {
+            let window = &pad[x..x + taps];
+            let mut acc = 0i32;
+            for (kc, vc) in weights.chunks_exact(LANES).zip(window.chunks_exact(LANES)) {
+                for (&k, &v) in kc.iter().zip(vc) {
+                    acc += i32::from(k) * i32::from(v);
                 }
             }
-            dst[at(i)] = (acc >> 15) as u16;
+            let acc = (acc + (1 << 30)) as u32;
+            dst[x * h + y] = ((acc + ONE_Q15 / 2) >> 15) as u16;
         }
     }
 }
@@ -313,9 +329,15 @@ fn gaussian_level(dog: &Dog, work: &mut DogWork, i: u8, pw: usize, ph: usize) {
     let r = gaussian_kernel(sigma, dog.radius_plane(i), &mut work.kernel);
     let kernel = &work.kernel[..2 * r + 1];
     let n = pw * ph;
-    blur_lines(&work.base[..n], &mut work.tmp[..n], ph, pw, pw, 1, kernel);
+    blur_rows_transposed(
+        &work.base[..n],
+        &mut work.tmp[..n],
+        pw,
+        kernel,
+        &mut work.pad,
+    );
     let dst = &mut work.ring[usize::from(i) % 4][..n];
-    blur_lines(&work.tmp[..n], dst, pw, ph, 1, pw, kernel);
+    blur_rows_transposed(&work.tmp[..n], dst, ph, kernel, &mut work.pad);
 }
 
 /// Scale-space maxima of the normalised DoG into `work.blobs`.
