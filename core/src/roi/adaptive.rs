@@ -3,10 +3,10 @@
 //!
 //! The block mean is exact: the block is `block × block` pixels centred on the pixel
 //! and clipped to the frame (fewer pixels near the edges), and the test
-//! `v > mean + offset` is evaluated as `v·count > sum + offset·count` in integers, so
-//! no division and no rounding enter the mask. Block sums come from column sums over
-//! the `block` rows around the current row, updated by one row in and one row out,
-//! then slid along the row: scratch memory is O(width), never O(pixels).
+//! `v > mean + offset` is evaluated as `(v − offset)·count > sum` in integers, so no
+//! division and no rounding enter the mask. Block sums come from column sums over the
+//! `block` rows around the current row, updated by one row in and one row out, and
+//! their prefix sums along the row: scratch memory is O(width), never O(pixels).
 
 use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
@@ -42,6 +42,8 @@ impl Default for Adaptive {
 pub struct AdaptiveWork {
     /// Sum of each column over the rows of the current block (≤ 248 · 65 535).
     column_sum: [u32; FRAME_WIDTH],
+    /// Prefix sums of `column_sum` along the row (`prefix[x]` = sum of columns < x).
+    prefix: [u64; FRAME_WIDTH + 1],
     mask: [bool; FRAME_WIDTH],
 }
 
@@ -57,6 +59,7 @@ impl AdaptiveScratch {
         Scratch {
             work: AdaptiveWork {
                 column_sum: [0; FRAME_WIDTH],
+                prefix: [0; FRAME_WIDTH + 1],
                 mask: [false; FRAME_WIDTH],
             },
             roi: RoiBuilder::new(),
@@ -102,6 +105,8 @@ impl Detector for Adaptive {
         let offset = i64::from(self.offset_dn);
         let col = &mut work.column_sum[..w];
         let mask = &mut work.mask[..w];
+        let prefix = &mut work.prefix[..=w];
+        prefix[0] = 0;
         let row_at = |y: usize| frame.row(y).unwrap_or(&[]);
 
         col.fill(0);
@@ -118,21 +123,20 @@ impl Detector for Adaptive {
                 }
             }
             let rows = (y + r).min(h - 1) + 1 - y.saturating_sub(r);
-            // Sliding sum over the clipped window [x − r, x + r] of the column sums.
-            let mut sum: u64 = col[..=r.min(w - 1)].iter().map(|&c| u64::from(c)).sum();
+            // Prefix sums of the column sums: the block sum of any clipped window is
+            // one subtraction.
+            let mut acc = 0u64;
+            for (p, &c) in prefix[1..].iter_mut().zip(col.iter()) {
+                acc += u64::from(c);
+                *p = acc;
+            }
+            // v > mean + offset  ⇔  (v − offset)·count > sum, exactly, in integers.
             for (x, (m, &v)) in mask.iter_mut().zip(row).enumerate() {
-                if x > 0 {
-                    if x + r < w {
-                        sum += u64::from(col[x + r]);
-                    }
-                    if x > r {
-                        sum -= u64::from(col[x - r - 1]);
-                    }
-                }
-                let cols = (x + r).min(w - 1) + 1 - x.saturating_sub(r);
-                let count = (rows * cols) as i64;
-                let v = i64::from(v.min(max_dn));
-                *m = v * count > sum as i64 + offset * count;
+                let lo = x.saturating_sub(r);
+                let hi = (x + r + 1).min(w);
+                let count = (rows * (hi - lo)) as i64;
+                let sum = (prefix[hi] - prefix[lo]) as i64;
+                *m = (i64::from(v.min(max_dn)) - offset) * count > sum;
             }
             sink(y, mask);
         }
