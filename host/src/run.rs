@@ -6,7 +6,7 @@ use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
-use tirroi_core::{DetectError, Detection, Detector, Frame, Method};
+use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Method};
 
 /// The four detectors with their parameters and their scratch memory (boxed: DoG's
 /// is 70 KiB), ready to run frame after frame.
@@ -41,6 +41,14 @@ impl Default for DetectorBank {
 }
 
 impl DetectorBank {
+    /// Sets the mask-to-box rule of every detector.
+    pub fn set_box_rule(&mut self, rule: BoxRule) {
+        self.otsu.box_rule = rule;
+        self.adaptive.box_rule = rule;
+        self.wge.box_rule = rule;
+        self.dog.box_rule = rule;
+    }
+
     /// Runs `method` on `frame`.
     ///
     /// # Errors

@@ -131,12 +131,26 @@ impl Detector for Adaptive {
                 *p = acc;
             }
             // v > mean + offset  ⇔  (v − offset)·count > sum, exactly, in integers.
-            for (x, (m, &v)) in mask.iter_mut().zip(row).enumerate() {
-                let lo = x.saturating_sub(r);
-                let hi = (x + r + 1).min(w);
-                let count = (rows * (hi - lo)) as i64;
-                let sum = (prefix[hi] - prefix[lo]) as i64;
-                *m = (i64::from(v.min(max_dn)) - offset) * count > sum;
+            // Columns r..w−r see the whole window: a branch-free loop over shifted
+            // prefix slices. The clipped columns near the edges take the general path.
+            let test = |v: u16, count: usize, sum: u64| {
+                (i64::from(v.min(max_dn)) - offset) * count as i64 > sum as i64
+            };
+            let full = 2 * r + 1;
+            let (left, interior) = if w >= full { (r, w - full + 1) } else { (w, 0) };
+            let count = rows * full;
+            let hi = &prefix[full..full + interior];
+            let lo = &prefix[..interior];
+            let (mask_in, row_in) = (
+                &mut mask[left..left + interior],
+                &row[left..left + interior],
+            );
+            for (((m, &v), &p_hi), &p_lo) in mask_in.iter_mut().zip(row_in).zip(hi).zip(lo) {
+                *m = test(v, count, p_hi - p_lo);
+            }
+            for x in (0..left).chain(left + interior..w) {
+                let (lo, hi) = (x.saturating_sub(r), (x + r + 1).min(w));
+                mask[x] = test(row[x], rows * (hi - lo), prefix[hi] - prefix[lo]);
             }
             sink(y, mask);
         }

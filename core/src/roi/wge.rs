@@ -93,16 +93,28 @@ pub fn prewitt_row(rows: [&[u16]; 3], max_dn: u16, out: &mut [u32]) {
     let (m0, m2) = (&r1[..n], &r1[2..n + 2]);
     let (b0, b1, b2) = (&r2[..n], &r2[1..=n], &r2[2..n + 2]);
     let inner = &mut out[1..=n];
-    // `min` on offset-signed values: the same as `v.min(max_dn)`, but SSE2 (which has
-    // no unsigned 16-bit min) vectorises it as `pminsw`.
-    let max_signed = (max_dn ^ 0x8000) as i16;
-    let c = |v: u16| i32::from(((v ^ 0x8000) as i16).min(max_signed) as u16 ^ 0x8000);
-    for i in 0..n {
-        let left = c(t0[i]) + c(m0[i]) + c(b0[i]);
-        let right = c(t2[i]) + c(m2[i]) + c(b2[i]);
-        let top = c(t0[i]) + c(t1[i]) + c(t2[i]);
-        let bottom = c(b0[i]) + c(b1[i]) + c(b2[i]);
-        inner[i] = (right - left).unsigned_abs() + (bottom - top).unsigned_abs();
+    if u32::from(max_dn) * 3 <= u32::from(u16::MAX) {
+        // Up to 14-bit DN, sums of three fit a u16 and |a − b| = max − min: the loop
+        // runs on twice as many SIMD lanes as in i32.
+        let c = |v: u16| v.min(max_dn);
+        for i in 0..n {
+            let left = c(t0[i]) + c(m0[i]) + c(b0[i]);
+            let right = c(t2[i]) + c(m2[i]) + c(b2[i]);
+            let top = c(t0[i]) + c(t1[i]) + c(t2[i]);
+            let bottom = c(b0[i]) + c(b1[i]) + c(b2[i]);
+            let gx = right.max(left) - right.min(left);
+            let gy = bottom.max(top) - bottom.min(top);
+            inner[i] = u32::from(gx) + u32::from(gy);
+        }
+    } else {
+        let c = |v: u16| i32::from(v.min(max_dn));
+        for i in 0..n {
+            let left = c(t0[i]) + c(m0[i]) + c(b0[i]);
+            let right = c(t2[i]) + c(m2[i]) + c(b2[i]);
+            let top = c(t0[i]) + c(t1[i]) + c(t2[i]);
+            let bottom = c(b0[i]) + c(b1[i]) + c(b2[i]);
+            inner[i] = (right - left).unsigned_abs() + (bottom - top).unsigned_abs();
+        }
     }
     out[0] = 0;
     out[w - 1] = 0;
@@ -137,7 +149,9 @@ impl Wge {
         hist.fill(0);
         for_each_gradient_row(frame, grad, |_, g| {
             for &v in &g[1..w - 1] {
-                hist[(v >> shift) as usize] += 1;
+                // `& (COARSE_BINS − 1)` never changes the index (g ≤ 6·max_dn <
+                // 2^(bits+3)); it lets the compiler drop the bounds check.
+                hist[(v >> shift) as usize & (COARSE_BINS - 1)] += 1;
             }
         });
         // The coarse bin holding the k-th value and how many lie below it.
@@ -160,8 +174,9 @@ impl Wge {
         let width = 1u32 << shift;
         for_each_gradient_row(frame, grad, |_, g| {
             for &v in &g[1..w - 1] {
-                if v.wrapping_sub(lo) < width {
-                    hist[(v - lo) as usize] += 1;
+                let d = v.wrapping_sub(lo);
+                if d < width {
+                    hist[d as usize & (COARSE_BINS - 1)] += 1;
                 }
             }
         });
