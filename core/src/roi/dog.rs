@@ -310,8 +310,13 @@ fn downsample(frame: &Frame<'_>, work: &mut DogWork, pw: usize) {
     for (py, band) in frame.pixels().chunks(w * DOWNSAMPLE).enumerate() {
         row_sum.fill(0);
         for row in band.chunks_exact(w) {
-            for (px, block) in row.chunks(DOWNSAMPLE).enumerate() {
-                row_sum[px] += block.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
+            let blocks = row.chunks_exact(DOWNSAMPLE);
+            let tail = blocks.remainder();
+            for (acc, block) in row_sum.iter_mut().zip(blocks) {
+                *acc += block.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
+            }
+            if let Some(acc) = row_sum.get_mut(w / DOWNSAMPLE) {
+                *acc += tail.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
             }
         }
         let rows = (h - py * DOWNSAMPLE).min(DOWNSAMPLE);
@@ -344,9 +349,9 @@ fn gaussian_level(dog: &Dog, work: &mut DogWork, i: u8, pw: usize, ph: usize) {
 fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
     work.blob_count = 0;
     let levels = dog.levels;
-    let layers = levels - 1;
+    let layers_total = levels - 1;
     let mut norm = [0i32; MAX_LEVELS as usize];
-    for (i, n) in norm.iter_mut().enumerate().take(usize::from(layers)) {
+    for (i, n) in norm.iter_mut().enumerate().take(usize::from(layers_total)) {
         *n = libm::roundf(dog.sigma_px(i as u8) / dog.sigma0_px * NORM_Q as f32) as i32;
     }
     let min_response = i32::try_from(dog.min_response_dn)
@@ -354,39 +359,55 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
         .saturating_mul(NORM_Q);
     gaussian_level(dog, work, 0, pw, ph);
     gaussian_level(dog, work, 1, pw, ph);
-    for i in 0..layers {
+    for i in 0..layers_total {
         if i + 2 < levels {
             gaussian_level(dog, work, i + 2, pw, ph);
         }
-        let response = |ring: &[[u16; PLANE]; 4], layer: u8, idx: usize| -> i32 {
-            let a = i32::from(ring[usize::from(layer) % 4][idx]);
-            let b = i32::from(ring[usize::from(layer + 1) % 4][idx]);
-            (a - b) * norm[usize::from(layer)]
+        let n = pw * ph;
+        let DogWork {
+            ring,
+            blobs,
+            blob_count,
+            ..
+        } = &mut *work;
+        // Layer l is (G_l − G_{l+1})·norm_l; its two planes come from the ring.
+        let planes = |l: u8| {
+            (
+                &ring[usize::from(l) % 4][..n],
+                &ring[usize::from(l + 1) % 4][..n],
+                norm[usize::from(l)],
+            )
         };
-        let lo_layer = i.saturating_sub(1);
-        let hi_layer = (i + 1).min(layers - 1);
+        let response = |(a, b, k): (&[u16], &[u16], i32), idx: usize| {
+            (i32::from(a[idx]) - i32::from(b[idx])) * k
+        };
+        let current = planes(i);
+        // Same layer first (most candidates fail there), then the layers below/above.
+        let mut neighbours = [current; 3];
+        let mut layers = 1;
+        if i > 0 {
+            neighbours[layers] = planes(i - 1);
+            layers += 1;
+        }
+        if i + 1 < layers_total {
+            neighbours[layers] = planes(i + 1);
+            layers += 1;
+        }
         for y in 0..ph {
+            let (y0, y1) = (y.saturating_sub(1), (y + 1).min(ph - 1));
             for x in 0..pw {
-                let r = response(&work.ring, i, y * pw + x);
+                let r = response(current, y * pw + x);
                 if r < min_response || r <= 0 {
                     continue;
                 }
-                let mut is_max = true;
-                'search: for layer in lo_layer..=hi_layer {
-                    for ny in y.saturating_sub(1)..=(y + 1).min(ph - 1) {
-                        for nx in x.saturating_sub(1)..=(x + 1).min(pw - 1) {
-                            if (layer, ny, nx) != (i, y, x)
-                                && response(&work.ring, layer, ny * pw + nx) > r
-                            {
-                                is_max = false;
-                                break 'search;
-                            }
-                        }
-                    }
-                }
-                if is_max {
+                let (x0, x1) = (x.saturating_sub(1), (x + 1).min(pw - 1));
+                let beaten = neighbours[..layers].iter().any(|&layer| {
+                    (y0..=y1).any(|ny| (x0..=x1).any(|nx| response(layer, ny * pw + nx) > r))
+                });
+                if !beaten {
                     keep_blob(
-                        work,
+                        blobs,
+                        blob_count,
                         Blob {
                             x: x as u16,
                             y: y as u16,
@@ -401,13 +422,13 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
 }
 
 /// Adds `blob`, or replaces the weakest kept blob when the list is full.
-fn keep_blob(work: &mut DogWork, blob: Blob) {
-    if work.blob_count < MAX_BLOBS {
-        work.blobs[work.blob_count] = blob;
-        work.blob_count += 1;
+fn keep_blob(blobs: &mut [Blob; MAX_BLOBS], count: &mut usize, blob: Blob) {
+    if let Some(slot) = blobs.get_mut(*count) {
+        *slot = blob;
+        *count += 1;
         return;
     }
-    if let Some(weakest) = work.blobs.iter_mut().min_by_key(|b| b.response) {
+    if let Some(weakest) = blobs.iter_mut().min_by_key(|b| b.response) {
         if weakest.response < blob.response {
             *weakest = blob;
         }

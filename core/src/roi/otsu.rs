@@ -42,9 +42,7 @@ pub struct Otsu {
 pub struct OtsuWork {
     /// Per coarse bin: pixel count in the high 32 bits, sum of `v − bin_start` in the
     /// low 32 (≤ 2^8 · 81 344 < 2^32), so the histogram pass does one add per pixel.
-    /// Two interleaved copies (even and odd pixels) halve the store-to-load chains
-    /// that runs of equal bins cause.
-    coarse: [[u64; COARSE_BINS]; 2],
+    coarse: [u64; COARSE_BINS],
     /// Pixels per DN of the bins being refined.
     fine: [u32; FINE_SLOTS],
     /// Position of each coarse bin in `fine` (in bins), or [`NOT_REFINED`].
@@ -63,7 +61,7 @@ impl OtsuScratch {
     pub const fn new() -> Self {
         Scratch {
             work: OtsuWork {
-                coarse: [[0; COARSE_BINS]; 2],
+                coarse: [0; COARSE_BINS],
                 fine: [0; FINE_SLOTS],
                 slot: [NOT_REFINED; COARSE_BINS],
                 mask: [false; FRAME_WIDTH],
@@ -166,33 +164,15 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
     let bins = (usize::from(max_dn) >> shift) + 1;
     let low_mask = (bin_width - 1) as u16;
 
-    let [even, odd] = &mut work.coarse;
-    even.fill(0);
-    odd.fill(0);
-    // `& (COARSE_BINS − 1)` never changes an index (v >> shift < 256); it lets the
-    // compiler drop the bounds check.
-    let entry = |v: u16| {
+    let coarse = &mut work.coarse;
+    coarse.fill(0);
+    for &v in frame.pixels() {
         let v = v.min(max_dn);
-        (
-            usize::from(v >> shift) & (COARSE_BINS - 1),
-            (1 << 32) | u64::from(v & low_mask),
-        )
-    };
-    let mut pairs = frame.pixels().chunks_exact(2);
-    for pair in &mut pairs {
-        let (a, ea) = entry(pair[0]);
-        let (b, eb) = entry(pair[1]);
-        even[a] += ea;
-        odd[b] += eb;
+        // `& (COARSE_BINS − 1)` never changes the index (v >> shift < 256); it lets the
+        // compiler drop the bounds check.
+        coarse[usize::from(v >> shift) & (COARSE_BINS - 1)] += (1 << 32) | u64::from(v & low_mask);
     }
-    for &v in pairs.remainder() {
-        let (a, ea) = entry(v);
-        even[a] += ea;
-    }
-    for (e, &o) in even.iter_mut().zip(odd.iter()) {
-        *e += o;
-    }
-    let coarse = &*even;
+    let coarse = &*coarse;
     let count = |b: usize| coarse[b] >> 32;
     let sum = |b: usize| count(b) * ((b as u64) << shift) + (coarse[b] & 0xFFFF_FFFF);
     let totals = Totals {
