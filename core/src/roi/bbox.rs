@@ -122,3 +122,26 @@ impl Roi {
         [self.x0, self.y0, self.x1, self.y1]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Roi;
+
+    #[test]
+    fn area_iou_and_clip() {
+        let a = Roi::new(0, 0, 4, 4);
+        let b = Roi::new(2, 2, 6, 6);
+        assert_eq!(a.area(), 16);
+        assert_eq!(a.intersection(&b), Roi::new(2, 2, 4, 4));
+        assert_eq!(a.hull(&b), Roi::new(0, 0, 6, 6));
+        // 4 / (16 + 16 − 4)
+        assert!((a.iou(&b) - 4.0 / 28.0).abs() < 1e-7);
+        assert_eq!(a.iou(&b), b.iou(&a));
+        assert_eq!(a.iou(&a), 1.0);
+        assert_eq!(Roi::EMPTY.iou(&Roi::EMPTY), 0.0);
+        assert_eq!(b.clip(5, 3), Roi::new(2, 2, 5, 3));
+        assert_eq!(b.clip(2, 2), Roi::EMPTY);
+        assert!(Roi::new(3, 1, 3, 5).is_empty());
+        assert_eq!(Roi::new(5, 5, 2, 2).area(), 0);
+    }
+}

@@ -354,3 +354,87 @@ fn last_set(mask: &[bool]) -> Option<usize> {
     }
     chunks.remainder().iter().rposition(|&m| m)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs `rows` (ASCII art, `#` = foreground) through a builder.
+    fn boxes(rows: &[&str], rule: BoxRule) -> (Option<Roi>, u32) {
+        let mut b = RoiBuilder::new();
+        b.start(rule, rows[0].len());
+        for (y, row) in rows.iter().enumerate() {
+            let mask: [bool; 64] = core::array::from_fn(|x| row.as_bytes().get(x) == Some(&b'#'));
+            b.push_row(y, &mask[..row.len()]);
+        }
+        b.finish()
+    }
+
+    #[test]
+    fn u_shape_merges_late_into_one_component() {
+        let rows = ["#...#..##", "#...#..##", "#...#....", "#####...."];
+        assert_eq!(
+            boxes(&rows, BoxRule::LargestComponent),
+            (Some(Roi::new(0, 0, 5, 4)), 15)
+        );
+        assert_eq!(
+            boxes(&rows, BoxRule::AllForeground),
+            (Some(Roi::new(0, 0, 9, 4)), 15)
+        );
+    }
+
+    #[test]
+    fn diagonal_pixels_are_connected() {
+        let rows = ["#....", ".#...", "..#..", "....#"];
+        assert_eq!(
+            boxes(&rows, BoxRule::LargestComponent),
+            (Some(Roi::new(0, 0, 3, 3)), 4)
+        );
+    }
+
+    #[test]
+    fn ties_go_to_the_first_component_in_raster_order() {
+        let rows = ["...##", "##...", "....."];
+        assert_eq!(
+            boxes(&rows, BoxRule::LargestComponent).0,
+            Some(Roi::new(3, 0, 5, 1))
+        );
+    }
+
+    #[test]
+    fn empty_mask_and_checkerboard() {
+        assert_eq!(boxes(&["...", "..."], BoxRule::LargestComponent), (None, 0));
+        // A full-width checkerboard is one 8-connected component.
+        let even: [u8; 328] = core::array::from_fn(|x| if x % 2 == 0 { b'#' } else { b'.' });
+        let odd: [u8; 328] = core::array::from_fn(|x| if x % 2 == 1 { b'#' } else { b'.' });
+        let (even, odd) = (
+            core::str::from_utf8(&even).unwrap(),
+            core::str::from_utf8(&odd).unwrap(),
+        );
+        let mut b = RoiBuilder::new();
+        b.start(BoxRule::LargestComponent, 328);
+        for y in 0..248 {
+            let row = if y % 2 == 0 { even } else { odd };
+            let mask: [bool; 328] = core::array::from_fn(|x| row.as_bytes()[x] == b'#');
+            b.push_row(y, &mask);
+        }
+        assert_eq!(b.finish(), (Some(Roi::new(0, 0, 328, 248)), 164 * 248));
+    }
+
+    #[test]
+    fn capacity_holds_164_stripes_alive_at_once() {
+        // 164 one-pixel stripes stay open for the whole frame; then one row joins all.
+        let mut b = RoiBuilder::new();
+        b.start(BoxRule::LargestComponent, 328);
+        let stripes: [bool; 328] = core::array::from_fn(|x| x % 2 == 0);
+        for y in 0..247 {
+            b.push_row(y, &stripes);
+        }
+        assert_eq!(b.clone().finish().0, Some(Roi::new(0, 0, 1, 247)));
+        b.push_row(247, &[true; 328]);
+        assert_eq!(
+            b.finish(),
+            (Some(Roi::new(0, 0, 328, 248)), 164 * 247 + 328)
+        );
+    }
+}
