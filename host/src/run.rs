@@ -10,6 +10,7 @@ use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Method};
 
 /// The four detectors with their parameters and their scratch memory (boxed: DoG's
 /// is 70 KiB), ready to run frame after frame.
+#[derive(Default)]
 pub struct DetectorBank {
     /// Otsu parameters.
     pub otsu: Otsu,
@@ -23,21 +24,6 @@ pub struct DetectorBank {
     adaptive_scratch: Box<AdaptiveScratch>,
     wge_scratch: Box<WgeScratch>,
     dog_scratch: Box<DogScratch>,
-}
-
-impl Default for DetectorBank {
-    fn default() -> Self {
-        DetectorBank {
-            otsu: Otsu::default(),
-            adaptive: Adaptive::default(),
-            wge: Wge::default(),
-            dog: Dog::default(),
-            otsu_scratch: Box::default(),
-            adaptive_scratch: Box::default(),
-            wge_scratch: Box::default(),
-            dog_scratch: Box::default(),
-        }
-    }
 }
 
 impl DetectorBank {

@@ -139,7 +139,7 @@ impl Detector for Adaptive {
             let full = 2 * r + 1;
             let (left, interior) = if w >= full { (r, w - full + 1) } else { (w, 0) };
             let count = rows * full;
-            let hi = &prefix[full..full + interior];
+            let hi = prefix.get(full..full + interior).unwrap_or(&[]);
             let lo = &prefix[..interior];
             let (mask_in, row_in) = (
                 &mut mask[left..left + interior],

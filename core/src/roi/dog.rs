@@ -7,10 +7,11 @@
 //!    pixels), are computed one at a time with separable fixed-point kernels (Q15
 //!    weights summing exactly to 1, replicated borders). Only four levels are kept in
 //!    a ring: the three DoG layers an extremum test needs come from them.
-//! 3. The scale-normalised response `R_i = (G_i − G_{i+1}) · σ_i/σ_0` (bright blobs are
-//!    positive) is searched for local maxima over space and scale (3×3×3, `≥` every
-//!    neighbour present) with `R_i ≥ min_response_dn`. The strongest
-//!    [`MAX_BLOBS`] are kept.
+//! 3. The scale-normalised response `R_i = (G_i − G_{i+1}) / (k − 1)` with
+//!    `k = sigma_ratio` (the difference of Gaussians is already `≈ (k − 1)·σ²∇²G`, so this
+//!    reads as σ²∇²G in DN; bright blobs are positive) is searched for local maxima
+//!    over space and scale (3×3×3, `≥` every neighbour present) with
+//!    `R_i ≥ min_response_dn`. The strongest [`MAX_BLOBS`] are kept.
 //! 4. Each blob is the square of half-side `⌈√2·σ_i⌉` around its centre; the union of
 //!    the blob squares is the foreground mask handed to the [`BoxRule`] (all blobs'
 //!    hull, or the largest group of overlapping blobs).
@@ -40,7 +41,7 @@ const LANES: usize = 8;
 const KERNEL_CAPACITY: usize = (2 * MAX_RADIUS + 1).next_multiple_of(LANES);
 /// Fixed-point scale of the kernel weights (Q15).
 const ONE_Q15: u32 = 1 << 15;
-/// Fixed-point scale of the scale normalisation σ_i/σ_0 (Q4).
+/// Fixed-point scale of the response normalisation 1/(k − 1) (Q4).
 const NORM_Q: i32 = 16;
 
 /// Parameters of the DoG blob detector.
@@ -350,10 +351,10 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
     work.blob_count = 0;
     let levels = dog.levels;
     let layers_total = levels - 1;
-    let mut norm = [0i32; MAX_LEVELS as usize];
-    for (i, n) in norm.iter_mut().enumerate().take(usize::from(layers_total)) {
-        *n = libm::roundf(dog.sigma_px(i as u8) / dog.sigma0_px * NORM_Q as f32) as i32;
-    }
+    // G(kσ) − G(σ) ≈ (k − 1)·σ²∇²G: the difference is already scale-normalised; only
+    // the constant 1/(k − 1) remains, so that responses read as σ²∇²G in DN.
+    let norm = [libm::roundf(NORM_Q as f32 / (dog.sigma_ratio - 1.0)).max(1.0) as i32;
+        MAX_LEVELS as usize];
     let min_response = i32::try_from(dog.min_response_dn)
         .unwrap_or(i32::MAX)
         .saturating_mul(NORM_Q);

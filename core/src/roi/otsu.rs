@@ -194,8 +194,8 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
             best.offer(s, n0, (((b + 1) << shift) - 1) as u16);
         }
     }
-    if best.n0 == u64::MAX || bin_width == 1 {
-        // No split (a single DN value: all background), or already at full resolution.
+    if bin_width == 1 {
+        // Already at full resolution (no split at all: a single DN value, all background).
         return best.t;
     }
 
@@ -208,14 +208,14 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
         slot.fill(NOT_REFINED);
         let mut picked = 0u8;
         let (mut n_a, mut m_a) = (0u64, 0u64);
-        for b in 0..bins {
+        for (b, bin_slot) in slot[..bins].iter_mut().enumerate() {
             let (n_b, m_b) = (n_a + count(b), m_a + sum(b));
             if b >= next_bin
                 && usize::from(picked) < bins_per_pass
                 && count(b) > 1
                 && bin_may_beat(&totals, &best, b, shift, (n_a, m_a), (n_b, m_b))
             {
-                slot[b] = picked;
+                *bin_slot = picked;
                 picked += 1;
                 next_bin = b + 1;
             }
@@ -236,8 +236,7 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
         }
         // Exact scores at every DN of the picked bins.
         let (mut n0, mut m0) = (0u64, 0u64);
-        for b in 0..bins {
-            let s = slot[b];
+        for (b, &s) in slot[..bins].iter().enumerate() {
             if s != NOT_REFINED {
                 let (mut n, mut m) = (n0, m0);
                 let base = usize::from(s) * bin_width;

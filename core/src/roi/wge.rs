@@ -220,10 +220,11 @@ impl Detector for Wge {
         let (w, h) = (frame.width(), frame.height());
         let interior = (w.saturating_sub(2) * h.saturating_sub(2)) as u32;
         let k = self.drop_count(interior);
-        let threshold = match self.order_statistic(frame, work, k) {
-            Some(t) => t.max(self.min_gradient),
-            None => u32::MAX,
-        };
+        let threshold = match interior {
+            0 => None,
+            _ => self.order_statistic(frame, work, k),
+        }
+        .map_or(u32::MAX, |t| t.max(self.min_gradient));
         let WgeWork { gradient, mask, .. } = work;
         let mask = &mut mask[..w];
         mask.fill(false);

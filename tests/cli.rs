@@ -1,0 +1,317 @@
+//! The `tirroi` binary end to end: fixtures on disk, `detect --json` lines that agree
+//! with the library, and one clean error line (exit code 2, no panic) per bad file.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+use serde_json::Value;
+use tirroi::core::roi::adaptive::Adaptive;
+use tirroi::core::roi::dog::{Dog, DogScratch};
+use tirroi::core::roi::otsu::Otsu;
+use tirroi::core::roi::wge::Wge;
+use tirroi::core::{Detection, Detector, Method, Roi};
+use tirroi::host::fixture;
+use tirroi::host::image_io::read_frame;
+
+/// The `tirroi` binary of this build (the root package cannot use
+/// `CARGO_BIN_EXE_tirroi`: the binary belongs to `tirroi-host`). It lives next to
+/// this test's `deps/` directory; cargo is asked once to bring it up to date (a no-op
+/// when it is), so a stale binary is never tested.
+fn tirroi() -> &'static Path {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| {
+        let exe = std::env::current_exe().expect("test executable path");
+        let profile_dir = exe
+            .parent()
+            .and_then(Path::parent)
+            .expect("test executables live in <target>/<profile>/deps");
+        let bin = profile_dir.join(format!("tirroi{}", std::env::consts::EXE_SUFFIX));
+        let target_dir = profile_dir.parent().expect("<target>/<profile>");
+        let profile = profile_dir
+            .file_name()
+            .and_then(|p| p.to_str())
+            .unwrap_or("debug");
+        let mut build = Command::new(env!("CARGO"));
+        build
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["build", "-q", "-p", "tirroi-host", "--bin", "tirroi"])
+            .arg("--target-dir")
+            .arg(target_dir);
+        match profile {
+            "debug" => {}
+            "release" => {
+                build.arg("--release");
+            }
+            other => {
+                build.args(["--profile", other]);
+            }
+        }
+        let status = build.status().expect("run cargo build");
+        assert!(status.success(), "cargo build of the tirroi binary failed");
+        assert!(bin.is_file(), "no binary at {}", bin.display());
+        bin
+    })
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(tirroi())
+        .args(args)
+        .output()
+        .expect("run tirroi")
+}
+
+fn stdout_lines(out: &Output) -> Vec<String> {
+    String::from_utf8(out.stdout.clone())
+        .expect("UTF-8 stdout")
+        .lines()
+        .map(str::to_owned)
+        .collect()
+}
+
+fn stderr_text(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Writes the fixture frames into a fresh temporary directory.
+fn fixtures() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let out = run(&["fixtures", "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    dir
+}
+
+/// What the library's default detector for `method` finds in the frame file `path`
+/// (read as the CLI reads it).
+fn library_detection(method: Method, path: &Path) -> Detection {
+    let buf = read_frame(path, None).expect("readable frame");
+    let frame = buf.view().expect("valid frame");
+    match method {
+        Method::Otsu => Otsu::default().detect(&frame, &mut Default::default()),
+        Method::Adaptive => Adaptive::default().detect(&frame, &mut Default::default()),
+        Method::Wge => Wge::default().detect(&frame, &mut Default::default()),
+        Method::Dog => Dog::default().detect(&frame, &mut Box::<DogScratch>::default()),
+    }
+    .expect("default parameters are valid")
+}
+
+/// Parses one `detect --json` line and checks its shape; returns (file, method, bbox).
+fn parse_line(line: &str) -> (String, String, Option<[u16; 4]>) {
+    let v: Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
+    let obj = v.as_object().expect("a JSON object per line");
+    let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    assert_eq!(keys, ["bbox", "file", "method", "time_us"], "{line}");
+    let time = obj["time_us"].as_f64().expect("time_us is a number");
+    assert!(time.is_finite() && time >= 0.0, "{line}");
+    let bbox = match &obj["bbox"] {
+        Value::Null => None,
+        Value::Array(a) => {
+            assert_eq!(a.len(), 4, "{line}");
+            let c: Vec<u16> = a
+                .iter()
+                .map(|n| {
+                    let n = n.as_u64().expect("integer coordinates");
+                    u16::try_from(n).expect("coordinate fits the frame")
+                })
+                .collect();
+            assert!(c[0] < c[2] && c[1] < c[3], "non-empty box: {line}");
+            Some([c[0], c[1], c[2], c[3]])
+        }
+        other => panic!("bbox is neither an array nor null: {other}"),
+    };
+    (
+        obj["file"].as_str().expect("file is a string").to_owned(),
+        obj["method"]
+            .as_str()
+            .expect("method is a string")
+            .to_owned(),
+        bbox,
+    )
+}
+
+#[test]
+fn fixtures_writes_pngs_and_truth() {
+    let dir = fixtures();
+    let csv = std::fs::read_to_string(dir.path().join("truth.csv")).expect("truth.csv");
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("file,x0,y0,x1,y1"));
+    let rows: Vec<&str> = lines.collect();
+    let set = fixture::standard_set();
+    assert_eq!(rows.len(), set.len());
+    for (row, (name, spec)) in rows.iter().zip(&set) {
+        let fx = fixture::render(spec);
+        let [x0, y0, x1, y1] = fx.truth.to_array();
+        assert_eq!(*row, format!("{name}.png,{x0},{y0},{x1},{y1}"));
+        // The PNG holds exactly the fixture's DN as 16-bit grayscale.
+        let path = dir.path().join(format!("{name}.png"));
+        let img = image::open(&path).expect("decodable PNG");
+        assert_eq!(img.color(), image::ColorType::L16, "{name}");
+        assert_eq!((img.width(), img.height()), (328, 248), "{name}");
+        assert_eq!(img.into_luma16().into_raw(), fx.frame.pixels, "{name}");
+        // And reads back as the 14-bit frame it was.
+        let buf = read_frame(&path, None).expect("readable frame");
+        assert_eq!(buf, fx.frame, "{name}");
+    }
+}
+
+#[test]
+fn detect_json_one_method() {
+    let dir = fixtures();
+    let file = dir.path().join("earth.png");
+    let file_arg = file.to_str().unwrap();
+    let out = run(&["detect", "--method", "otsu", "--json", file_arg]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    assert!(out.stderr.is_empty(), "{}", stderr_text(&out));
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    let (f, m, bbox) = parse_line(&lines[0]);
+    assert_eq!(f, file_arg);
+    assert_eq!(m, "otsu");
+    let want = library_detection(Method::Otsu, &file);
+    assert_eq!(bbox, want.roi.map(|r| r.to_array()));
+}
+
+#[test]
+fn detect_json_all_methods_and_files() {
+    let dir = fixtures();
+    let files: Vec<PathBuf> = ["deep-space", "earth-far"]
+        .iter()
+        .map(|n| dir.path().join(format!("{n}.png")))
+        .collect();
+    let mut args = vec!["detect", "--method", "all", "--json"];
+    args.extend(files.iter().map(|f| f.to_str().unwrap()));
+    let out = run(&args);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 4 * files.len(), "{lines:?}");
+    for (i, line) in lines.iter().enumerate() {
+        let (f, m, bbox) = parse_line(line);
+        let file = &files[i / 4];
+        let method = Method::ALL[i % 4];
+        assert_eq!(f, file.to_str().unwrap());
+        assert_eq!(m, method.name());
+        let want = library_detection(method, file);
+        assert_eq!(bbox, want.roi.map(|r| r.to_array()), "{line}");
+    }
+    // The default method is all four.
+    let out = run(&["detect", "--json", files[0].to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    assert_eq!(stdout_lines(&out).len(), 4);
+}
+
+#[test]
+fn detect_small_8_bit_png_with_known_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("square.png");
+    let mut img = image::GrayImage::from_pixel(20, 12, image::Luma([10]));
+    for y in 3..7 {
+        for x in 5..9 {
+            img.put_pixel(x, y, image::Luma([200]));
+        }
+    }
+    img.save(&path).unwrap();
+    let out = run(&[
+        "detect",
+        "--method",
+        "otsu",
+        "--json",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 1);
+    let (_, _, bbox) = parse_line(&lines[0]);
+    assert_eq!(bbox, Some(Roi::new(5, 3, 9, 7).to_array()));
+}
+
+/// Asserts a failed run: exit code 2, exactly one stderr line naming `file`, no panic.
+#[track_caller]
+fn assert_one_clean_error(out: &Output, file: &Path) {
+    let err = stderr_text(out);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "exactly one error line: {err}");
+    assert!(
+        lines[0].contains(file.to_str().unwrap()),
+        "the error names {}: {err}",
+        file.display()
+    );
+}
+
+#[test]
+fn bad_files_give_one_error_line_and_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.png");
+    let text_png = dir.path().join("notes.png");
+    std::fs::write(&text_png, "this is not a PNG\n").unwrap();
+    let text_txt = dir.path().join("notes.txt");
+    std::fs::write(&text_txt, "neither is this\n").unwrap();
+    let empty = dir.path().join("empty.png");
+    std::fs::write(&empty, b"").unwrap();
+    let rgb = dir.path().join("colour.png");
+    image::RgbImage::from_pixel(16, 8, image::Rgb([10, 200, 30]))
+        .save(&rgb)
+        .unwrap();
+    let large = dir.path().join("large.png");
+    image::GrayImage::from_pixel(400, 300, image::Luma([7]))
+        .save(&large)
+        .unwrap();
+    let large16 = dir.path().join("large16.png");
+    image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(329, 10, image::Luma([7]))
+        .save(&large16)
+        .unwrap();
+    for file in [
+        &missing, &text_png, &text_txt, &empty, &rgb, &large, &large16,
+    ] {
+        for method in ["otsu", "all"] {
+            let out = run(&[
+                "detect",
+                "--method",
+                method,
+                "--json",
+                file.to_str().unwrap(),
+            ]);
+            assert_one_clean_error(&out, file);
+            assert!(
+                out.stdout.is_empty(),
+                "{}",
+                String::from_utf8_lossy(&out.stdout)
+            );
+        }
+    }
+}
+
+#[test]
+fn a_bad_file_does_not_stop_the_good_ones() {
+    let dir = fixtures();
+    let good = dir.path().join("earth-close.png");
+    let bad = dir.path().join("missing.png");
+    let out = run(&[
+        "detect",
+        "--method",
+        "wge",
+        "--json",
+        bad.to_str().unwrap(),
+        good.to_str().unwrap(),
+    ]);
+    assert_one_clean_error(&out, &bad);
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    let (f, m, bbox) = parse_line(&lines[0]);
+    assert_eq!((f.as_str(), m.as_str()), (good.to_str().unwrap(), "wge"));
+    let want = library_detection(Method::Wge, &good);
+    assert_eq!(bbox, want.roi.map(|r| r.to_array()));
+}
+
+#[test]
+fn memory_lists_every_detectors_scratch_bytes() {
+    let out = run(&["memory"]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    for m in Method::ALL {
+        let row = format!("| {} | {} |", m.name(), m.scratch_bytes());
+        assert!(text.contains(&row), "missing {row:?} in:\n{text}");
+    }
+}
