@@ -11,7 +11,6 @@ use tirroi::core::roi::otsu::{self, Otsu, OtsuScratch};
 use tirroi::core::roi::wge::{self, Wge, WgeScratch};
 use tirroi::core::roi::{RoiBuilder, Scratch};
 use tirroi::core::{BoxRule, DetectError, Detector, Frame, Method, Roi};
-use tirroi::host::fixture;
 
 const W: usize = FRAME_WIDTH;
 const H: usize = FRAME_HEIGHT;
@@ -108,14 +107,7 @@ fn otsu_matches_exhaustive_search_on_full_frames() {
 
 #[test]
 fn otsu_matches_exhaustive_search_on_fixture_frames() {
-    for (name, spec) in fixture::standard_set() {
-        let fx = fixture::render(&spec);
-        let img = Img {
-            px: fx.frame.pixels,
-            w: fx.frame.width,
-            h: fx.frame.height,
-            bits: fx.frame.bits,
-        };
+    for (name, img) in fixture_imgs() {
         assert!(check_otsu(&img, name));
     }
 }
@@ -364,14 +356,7 @@ fn adaptive_matches_reference_on_full_frames() {
 
 #[test]
 fn adaptive_matches_reference_on_fixture_frames() {
-    for (name, spec) in fixture::standard_set() {
-        let fx = fixture::render(&spec);
-        let img = Img {
-            px: fx.frame.pixels,
-            w: fx.frame.width,
-            h: fx.frame.height,
-            bits: fx.frame.bits,
-        };
+    for (name, img) in fixture_imgs() {
         let d = Adaptive::default();
         check_adaptive(&img, d.block, d.offset_dn, name);
     }
@@ -533,14 +518,7 @@ fn wge_matches_reference_on_full_frames() {
 
 #[test]
 fn wge_matches_reference_on_fixture_frames() {
-    for (name, spec) in fixture::standard_set() {
-        let fx = fixture::render(&spec);
-        let img = Img {
-            px: fx.frame.pixels,
-            w: fx.frame.width,
-            h: fx.frame.height,
-            bits: fx.frame.bits,
-        };
+    for (name, img) in fixture_imgs() {
         let d = Wge::default();
         check_wge(&img, d.drop_fraction, d.min_gradient, name);
     }

@@ -887,3 +887,20 @@ pub fn distinct(px: &[u16]) -> usize {
 
 /// Both box rules.
 pub const RULES: [BoxRule; 2] = [BoxRule::AllForeground, BoxRule::LargestComponent];
+
+/// The host's procedural fixture frames as test images, with their names.
+pub fn fixture_imgs() -> Vec<(&'static str, Img)> {
+    tirroi::host::fixture::standard_set()
+        .into_iter()
+        .map(|(name, spec)| {
+            let frame = tirroi::host::fixture::render(&spec).frame;
+            let img = Img {
+                px: frame.pixels,
+                w: frame.width,
+                h: frame.height,
+                bits: frame.bits,
+            };
+            (name, img)
+        })
+        .collect()
+}
