@@ -8,9 +8,9 @@ use clap::{Parser, Subcommand};
 use serde::Serialize;
 use tirroi_core::{BoxRule, Method};
 
-use crate::fixture;
 use crate::image_io::read_frame;
 use crate::run::DetectorBank;
+use crate::{figure, fixture};
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
@@ -63,6 +63,10 @@ pub enum Command {
         /// Runs per frame and method; the reported time is the median.
         #[arg(long, default_value_t = 21)]
         repeat: u32,
+        /// Also write each frame with the detectors' boxes (largest-component rule) as
+        /// PNG into this directory.
+        #[arg(long)]
+        figures: Option<PathBuf>,
     },
 }
 
@@ -91,7 +95,10 @@ struct DetectLine<'a> {
 /// Runs the command line; returns the process exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command.unwrap_or(Command::Demo { repeat: 21 }) {
+    match cli.command.unwrap_or(Command::Demo {
+        repeat: 21,
+        figures: Some(PathBuf::from("docs")),
+    }) {
         Command::Detect {
             method,
             repeat,
@@ -107,7 +114,7 @@ pub fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Demo { repeat } => demo(repeat as usize),
+        Command::Demo { repeat, figures } => demo(repeat as usize, figures.as_deref()),
         Command::Fixtures { out } => match write_fixtures(&out) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
@@ -191,7 +198,13 @@ fn detect(
     }
 }
 
-fn demo(repeat: usize) -> ExitCode {
+fn demo(repeat: usize, figures: Option<&std::path::Path>) -> ExitCode {
+    if let Some(dir) = figures {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("tirroi: error: {}: cannot create: {e}", dir.display());
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    }
     println!("tirroi demo: the four detectors on procedural 328x248 14-bit frames");
     println!(
         "(not physically rendered: the renderer and the paper's tables come with later work)\n"
@@ -207,7 +220,8 @@ fn demo(repeat: usize) -> ExitCode {
             eprintln!("tirroi: error: fixture {name} does not fit the core");
             return ExitCode::from(EXIT_BAD_INPUT);
         };
-        for method in Method::ALL {
+        let mut drawn = vec![(fx.truth, figure::TRUTH_COLOUR)];
+        for (method, colour) in Method::ALL.into_iter().zip(figure::METHOD_COLOURS) {
             let mut cells = Vec::new();
             let mut time_us = 0.0;
             for rule in [BoxRule::AllForeground, BoxRule::LargestComponent] {
@@ -221,6 +235,8 @@ fn demo(repeat: usize) -> ExitCode {
                         cells.push(format!("{bbox} | {iou:.3}"));
                         if rule == BoxRule::AllForeground {
                             time_us = t;
+                        } else if let Some(r) = d.roi {
+                            drawn.push((r, colour));
                         }
                     }
                     Err(e) => {
@@ -235,6 +251,19 @@ fn demo(repeat: usize) -> ExitCode {
                 fx.truth.to_array()
             );
         }
+        if let Some(dir) = figures {
+            let img = figure::frame_with_boxes(&fx.frame, &drawn, 1);
+            if let Err(e) = figure::save(&img, &dir.join(format!("demo-{name}.png"))) {
+                eprintln!("tirroi: error: {e}");
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
+        }
+    }
+    if let Some(dir) = figures {
+        println!(
+            "\nFigures: {}/demo-*.png (green: truth; largest-component boxes: red Otsu, blue adaptive, yellow WGE, magenta DoG).",
+            dir.display()
+        );
     }
     println!(
         "\nTimes are for the all-foreground rule. Scratch memory per detector: `tirroi memory`."

@@ -6,6 +6,7 @@
 #![deny(missing_docs)]
 
 pub mod cli;
+pub mod figure;
 pub mod fixture;
 pub mod image_io;
 pub mod run;
