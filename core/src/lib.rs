@@ -13,14 +13,15 @@
 //!
 //! Each detector works in a [`roi::Scratch`] whose size is fixed at compile time; the
 //! caller owns it (a `static` on flight hardware, a local on the host). Bytes beyond
-//! the input frame, on x86-64 and on 32-bit Arm alike (asserted by tests):
+//! the input frame on x86-64 (32-bit targets save a few bytes of `usize` fields); the
+//! budgets are asserted by tests:
 //!
 //! | detector | scratch type | bytes | budget |
 //! |---|---|---|---|
-//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] (≈ 14.5 KiB) | 16 KiB |
-//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] (≈ 9.9 KiB) | 16 KiB |
-//! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] (≈ 13.6 KiB) | 16 KiB |
-//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] (≈ 70.5 KiB) | 96 KiB |
+//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] = 13 288 | 16 KiB |
+//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 12 880 | 16 KiB |
+//! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 344 | 16 KiB |
+//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 71 744 | 96 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in the README.
 #![no_std]

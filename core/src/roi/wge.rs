@@ -9,10 +9,14 @@
 //! (0-based), raised to at least `min_gradient`, and a pixel is foreground when
 //! `g ≥ threshold`. The order statistic is exact: a coarse histogram of
 //! [`COARSE_BINS`] bins finds the bin holding it, a second pass histograms that bin at
-//! full resolution, and a third pass streams the mask. No gradient image is stored;
-//! each pass recomputes the gradients of one row from three frame rows.
+//! full resolution, and a third pass streams the mask. For the all-foreground rule the
+//! second pass also keeps the hull of the pixels above that bin and, per gradient
+//! value inside it, the hull of its pixels, so the box needs no third pass (up to
+//! 14-bit DN, when `min_gradient` does not lift the threshold out of the bin). No
+//! gradient image is stored; each pass recomputes the gradients of one row from three
+//! frame rows.
 
-use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
 
 /// Coarse bins of the gradient histogram; the refinement pass reuses them as
@@ -134,15 +138,38 @@ fn for_each_gradient_row(frame: &Frame<'_>, buf: &mut [u32], mut f: impl FnMut(u
     }
 }
 
+/// What the histogram passes found.
+struct Passes {
+    /// The threshold (order statistic raised to `min_gradient`), `u32::MAX` when
+    /// everything is eliminated.
+    threshold: u32,
+    /// For the all-foreground rule, when the second pass could collect it: the hull of
+    /// the foreground and the foreground pixel count.
+    hull: Option<(Option<Roi>, u32)>,
+}
+
 impl Wge {
     /// Number of interior gradients eliminated out of `n`: `⌊drop_fraction·n⌋`.
     pub fn drop_count(&self, n: u32) -> u32 {
         ((self.drop_fraction * n as f32) as u32).min(n)
     }
 
-    /// The `k`-th smallest interior gradient (0-based), or `None` when `k ≥ N`.
-    fn order_statistic(&self, frame: &Frame<'_>, work: &mut WgeWork, k: u32) -> Option<u32> {
-        let w = frame.width();
+    /// The threshold: the `k`-th smallest interior gradient (0-based) by a coarse and a
+    /// fine histogram pass, raised to `min_gradient`. With `want_hull`, the fine pass
+    /// also collects the hull of the pixels above the bin and, per gradient value in
+    /// the bin, the hull of its pixels, so that the all-foreground box needs no third
+    /// pass (when the threshold stays inside the bin).
+    fn passes(&self, frame: &Frame<'_>, work: &mut WgeWork, want_hull: bool) -> Passes {
+        let (w, h) = (frame.width(), frame.height());
+        let interior = (w.saturating_sub(2) * h.saturating_sub(2)) as u32;
+        let none = Passes {
+            threshold: u32::MAX,
+            hull: want_hull.then_some((None, 0)),
+        };
+        if interior == 0 {
+            return none;
+        }
+        let k = self.drop_count(interior);
         let shift = (frame.bits() + 3).saturating_sub(COARSE_BITS);
         let WgeWork { hist, gradient, .. } = work;
         let grad = &mut gradient[..w];
@@ -154,39 +181,119 @@ impl Wge {
                 hist[(v >> shift) as usize & (COARSE_BINS - 1)] += 1;
             }
         });
-        // The coarse bin holding the k-th value and how many lie below it.
+        // The coarse bin holding the k-th value, how many lie below and above it.
         let mut below = 0u32;
-        let mut bin = None;
-        for (b, &c) in hist.iter().enumerate() {
-            if below + c > k {
-                bin = Some(b as u32);
-                break;
-            }
+        let Some(bin) = hist.iter().position(|&c| {
             below += c;
-        }
-        let bin = bin?;
+            below > k
+        }) else {
+            return none;
+        };
+        below -= hist[bin];
+        let above = interior - below - hist[bin];
+        let bin = bin as u32;
         if shift == 0 {
-            return Some(bin);
+            return Passes {
+                threshold: bin.max(self.min_gradient),
+                hull: None,
+            };
         }
-        // Full resolution inside that bin, reusing the histogram.
-        hist.fill(0);
+
+        // Full resolution inside that bin, reusing the histogram: counts, and with
+        // `want_hull` the hull of each value's pixels (x0, x1, y0 << 16 | y1).
         let lo = bin << shift;
-        let width = 1u32 << shift;
-        for_each_gradient_row(frame, grad, |_, g| {
-            for &v in &g[1..w - 1] {
-                let d = v.wrapping_sub(lo);
+        let width = 1usize << shift;
+        let hi = lo + width as u32 - 1;
+        let want_hull = want_hull && 4 * width <= COARSE_BINS;
+        let hull_width = if want_hull { width } else { 0 };
+        let (counts, rest) = hist.split_at_mut(width);
+        let (x0s, rest) = rest.split_at_mut(hull_width);
+        let (x1s, yys) = rest.split_at_mut(hull_width);
+        counts.fill(0);
+        let mut definite = Roi::EMPTY;
+        for_each_gradient_row(frame, grad, |y, g| {
+            if !want_hull {
+                for &v in &g[1..w - 1] {
+                    let d = v.wrapping_sub(lo) as usize;
+                    if d < width {
+                        counts[d] += 1;
+                    }
+                }
+                return;
+            }
+            let (mut first, mut last) = (usize::MAX, 0);
+            for (x, &v) in g.iter().enumerate().take(w - 1).skip(1) {
+                let d = v.wrapping_sub(lo) as usize;
                 if d < width {
-                    hist[d as usize & (COARSE_BINS - 1)] += 1;
+                    let (xs, ys) = (x as u32, y as u32);
+                    if counts[d] == 0 {
+                        (x0s[d], x1s[d], yys[d]) = (xs, xs, ys << 16 | ys);
+                    } else {
+                        x0s[d] = x0s[d].min(xs);
+                        x1s[d] = x1s[d].max(xs);
+                        yys[d] = (yys[d] & 0xFFFF_0000) | ys;
+                    }
+                    counts[d] += 1;
+                } else if v > hi {
+                    first = first.min(x);
+                    last = x;
                 }
             }
-        });
-        for (i, &c) in hist[..width as usize].iter().enumerate() {
-            if below + c > k {
-                return Some(lo + i as u32);
+            if first != usize::MAX {
+                let row = Roi::new(first as u16, y as u16, last as u16 + 1, y as u16 + 1);
+                definite = definite.hull(&row);
             }
+        });
+        let Some(offset) = counts.iter().position(|&c| {
             below += c;
+            below > k
+        }) else {
+            return none;
+        };
+        let threshold = (lo + offset as u32).max(self.min_gradient);
+        let hull = (want_hull && threshold <= hi).then(|| {
+            let from = (threshold - lo) as usize;
+            let mut roi = definite;
+            let mut n = above;
+            for d in from..width {
+                if counts[d] > 0 {
+                    let (y0, y1) = ((yys[d] >> 16) as u16, (yys[d] & 0xFFFF) as u16);
+                    let r = Roi::new(x0s[d] as u16, y0, x1s[d] as u16 + 1, y1 + 1);
+                    roi = roi.hull(&r);
+                    n += counts[d];
+                }
+            }
+            ((!roi.is_empty()).then_some(roi), n)
+        });
+        Passes { threshold, hull }
+    }
+
+    /// Streams the mask `g ≥ threshold` (interior only) to `sink`, every row once.
+    fn mask_pass<F: FnMut(usize, &[bool])>(
+        frame: &Frame<'_>,
+        work: &mut WgeWork,
+        threshold: u32,
+        mut sink: F,
+    ) {
+        let (w, h) = (frame.width(), frame.height());
+        let WgeWork { gradient, mask, .. } = work;
+        let mask = &mut mask[..w];
+        mask.fill(false);
+        if w < 3 || h < 3 || threshold == u32::MAX {
+            for y in 0..h {
+                sink(y, mask);
+            }
+            return;
         }
-        None
+        sink(0, mask);
+        for_each_gradient_row(frame, &mut gradient[..w], |y, g| {
+            for (m, &v) in mask[1..w - 1].iter_mut().zip(&g[1..w - 1]) {
+                *m = v >= threshold;
+            }
+            sink(y, mask);
+        });
+        mask.fill(false);
+        sink(h - 1, mask);
     }
 }
 
@@ -215,34 +322,38 @@ impl Detector for Wge {
         &self,
         frame: &Frame<'_>,
         work: &mut WgeWork,
-        mut sink: F,
+        sink: F,
     ) -> u32 {
-        let (w, h) = (frame.width(), frame.height());
-        let interior = (w.saturating_sub(2) * h.saturating_sub(2)) as u32;
-        let k = self.drop_count(interior);
-        let threshold = match interior {
-            0 => None,
-            _ => self.order_statistic(frame, work, k),
-        }
-        .map_or(u32::MAX, |t| t.max(self.min_gradient));
-        let WgeWork { gradient, mask, .. } = work;
-        let mask = &mut mask[..w];
-        mask.fill(false);
-        if interior == 0 || threshold == u32::MAX {
-            for y in 0..h {
-                sink(y, mask);
-            }
-            return threshold;
-        }
-        sink(0, mask);
-        for_each_gradient_row(frame, &mut gradient[..w], |y, g| {
-            for (m, &v) in mask[1..w - 1].iter_mut().zip(&g[1..w - 1]) {
-                *m = v >= threshold;
-            }
-            sink(y, mask);
-        });
-        mask.fill(false);
-        sink(h - 1, mask);
+        let threshold = self.passes(frame, work, false).threshold;
+        Self::mask_pass(frame, work, threshold, sink);
         threshold
+    }
+
+    /// As the provided method, but the all-foreground box usually comes out of the
+    /// histogram passes (two gradient passes instead of three); the result is the same.
+    fn detect(
+        &self,
+        frame: &Frame<'_>,
+        scratch: &mut Scratch<WgeWork>,
+    ) -> Result<Detection, DetectError> {
+        self.validate()?;
+        let Scratch { work, roi } = scratch;
+        let all = self.box_rule == BoxRule::AllForeground;
+        let passes = self.passes(frame, work, all);
+        if let Some((found, foreground_px)) = passes.hull {
+            return Ok(Detection {
+                roi: found,
+                threshold: passes.threshold,
+                foreground_px,
+            });
+        }
+        roi.start(self.box_rule, frame.width());
+        Self::mask_pass(frame, work, passes.threshold, |y, m| roi.push_row(y, m));
+        let (found, foreground_px) = roi.finish();
+        Ok(Detection {
+            roi: found,
+            threshold: passes.threshold,
+            foreground_px,
+        })
     }
 }
