@@ -19,10 +19,16 @@
 use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
 
-/// Coarse bins of the gradient histogram; the refinement pass reuses them as
-/// full-resolution counters (a bin spans at most 2^(16+3−10) = 512 gradient values).
+/// Counters of the gradient histogram: [`COARSE_LANES`] interleaved copies of
+/// `COARSE_BINS / COARSE_LANES` coarse bins (a bin spans `2^(bits+3−9)` gradient
+/// values: 256 at 14 bits), reused by the refinement pass as full-resolution counters.
 pub const COARSE_BINS: usize = 1024;
-const COARSE_BITS: u8 = 10;
+/// Interleaved copies of the coarse histogram: neighbouring pixels, which in a flat
+/// sky share a bin, count into different copies so increments do not wait on each
+/// other.
+pub const COARSE_LANES: usize = 2;
+const LANE_BINS: usize = COARSE_BINS / COARSE_LANES;
+const COARSE_BITS: u8 = 9;
 
 /// Parameters of the WGE detector.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,23 +180,36 @@ impl Wge {
         let WgeWork { hist, gradient, .. } = work;
         let grad = &mut gradient[..w];
         hist.fill(0);
-        for_each_gradient_row(frame, grad, |_, g| {
-            for &v in &g[1..w - 1] {
-                // `& (COARSE_BINS − 1)` never changes the index (g ≤ 6·max_dn <
-                // 2^(bits+3)); it lets the compiler drop the bounds check.
-                hist[(v >> shift) as usize & (COARSE_BINS - 1)] += 1;
+        {
+            let (even, odd) = hist.split_at_mut(LANE_BINS);
+            // `& (LANE_BINS − 1)` never changes an index (g ≤ 6·max_dn < 2^(bits+3));
+            // it lets the compiler drop the bounds check.
+            let bin = |v: u32| (v >> shift) as usize & (LANE_BINS - 1);
+            for_each_gradient_row(frame, grad, |_, g| {
+                let mut pairs = g[1..w - 1].chunks_exact(2);
+                for pair in &mut pairs {
+                    even[bin(pair[0])] += 1;
+                    odd[bin(pair[1])] += 1;
+                }
+                for &v in pairs.remainder() {
+                    even[bin(v)] += 1;
+                }
+            });
+            for (e, &o) in even.iter_mut().zip(odd.iter()) {
+                *e += o;
             }
-        });
+        }
+        let hist_coarse = &hist[..LANE_BINS];
         // The coarse bin holding the k-th value, how many lie below and above it.
         let mut below = 0u32;
-        let Some(bin) = hist.iter().position(|&c| {
+        let Some(bin) = hist_coarse.iter().position(|&c| {
             below += c;
             below > k
         }) else {
             return none;
         };
-        below -= hist[bin];
-        let above = interior - below - hist[bin];
+        below -= hist_coarse[bin];
+        let above = interior - below - hist_coarse[bin];
         let bin = bin as u32;
         if shift == 0 {
             return Passes {
