@@ -42,8 +42,10 @@ impl Default for Adaptive {
 pub struct AdaptiveWork {
     /// Sum of each column over the rows of the current block (≤ 248 · 65 535).
     column_sum: [u32; FRAME_WIDTH],
-    /// Prefix sums of `column_sum` along the row (`prefix[x]` = sum of columns < x).
-    prefix: [u64; FRAME_WIDTH + 1],
+    /// Prefix sums of `column_sum` along the row (`prefix[x]` = sum of columns < x),
+    /// modulo 2^32: any window's sum (≤ 249² · 65 535 < 2^32) is the exact wrapping
+    /// difference of two of them.
+    prefix: [u32; FRAME_WIDTH + 1],
     mask: [bool; FRAME_WIDTH],
 }
 
@@ -107,6 +109,11 @@ impl Detector for Adaptive {
         let mask = &mut work.mask[..w];
         let prefix = &mut work.prefix[..=w];
         prefix[0] = 0;
+        // With |v − offset| ≤ max_dn + |offset| and count ≤ block², i32 suffices when
+        // their product does (sums are at most count · max_dn, smaller still).
+        let block_px = u64::from(self.block) * u64::from(self.block);
+        let narrow = (u64::from(max_dn) + u64::from(self.offset_dn.unsigned_abs())) * block_px
+            <= i32::MAX as u64;
         let row_at = |y: usize| frame.row(y).unwrap_or(&[]);
 
         col.fill(0);
@@ -125,15 +132,15 @@ impl Detector for Adaptive {
             let rows = (y + r).min(h - 1) + 1 - y.saturating_sub(r);
             // Prefix sums of the column sums: the block sum of any clipped window is
             // one subtraction.
-            let mut acc = 0u64;
+            let mut acc = 0u32;
             for (p, &c) in prefix[1..].iter_mut().zip(col.iter()) {
-                acc += u64::from(c);
+                acc = acc.wrapping_add(c);
                 *p = acc;
             }
             // v > mean + offset  ⇔  (v − offset)·count > sum, exactly, in integers.
             // Columns r..w−r see the whole window: a branch-free loop over shifted
             // prefix slices. The clipped columns near the edges take the general path.
-            let test = |v: u16, count: usize, sum: u64| {
+            let test = |v: u16, count: usize, sum: u32| {
                 (i64::from(v.min(max_dn)) - offset) * count as i64 > sum as i64
             };
             let full = 2 * r + 1;
@@ -145,12 +152,24 @@ impl Detector for Adaptive {
                 &mut mask[left..left + interior],
                 &row[left..left + interior],
             );
-            for (((m, &v), &p_hi), &p_lo) in mask_in.iter_mut().zip(row_in).zip(hi).zip(lo) {
-                *m = test(v, count, p_hi - p_lo);
+            let pixels = mask_in.iter_mut().zip(row_in).zip(hi).zip(lo);
+            if narrow {
+                // Every product and sum fits an i32: twice the SIMD lanes of i64.
+                let (count, offset) = (count as i32, offset as i32);
+                let max_dn = i32::from(max_dn);
+                for (((m, &v), &p_hi), &p_lo) in pixels {
+                    let sum = p_hi.wrapping_sub(p_lo) as i32;
+                    *m = (i32::from(v).min(max_dn) - offset) * count > sum;
+                }
+            } else {
+                for (((m, &v), &p_hi), &p_lo) in pixels {
+                    *m = test(v, count, p_hi.wrapping_sub(p_lo));
+                }
             }
             for x in (0..left).chain(left + interior..w) {
                 let (lo, hi) = (x.saturating_sub(r), (x + r + 1).min(w));
-                mask[x] = test(row[x], rows * (hi - lo), prefix[hi] - prefix[lo]);
+                let sum = prefix[hi].wrapping_sub(prefix[lo]);
+                mask[x] = test(row[x], rows * (hi - lo), sum);
             }
             sink(y, mask);
         }
