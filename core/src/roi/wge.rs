@@ -223,16 +223,36 @@ impl Wge {
         let lo = bin << shift;
         let width = 1usize << shift;
         let hi = lo + width as u32 - 1;
-        let want_hull = want_hull && 4 * width <= COARSE_BINS;
-        let hull_width = if want_hull { width } else { 0 };
+        // Tracking hulls costs four counter updates per pixel of the bin: when the bin
+        // holds most of the frame (a flat sky), the third pass is cheaper.
+        let in_bin = interior - below - above;
+        let want_hull = want_hull && 4 * width <= COARSE_BINS && in_bin <= interior / 4;
+        // Without hulls, a second lane of counters (odd pixels) when it fits.
+        let lanes = !want_hull && 2 * width <= COARSE_BINS;
+        let hull_width = if want_hull || lanes { width } else { 0 };
         let (counts, rest) = hist.split_at_mut(width);
         let (x0s, rest) = rest.split_at_mut(hull_width);
-        let (x1s, yys) = rest.split_at_mut(hull_width);
+        let (x1s, yys) = rest.split_at_mut(if want_hull { width } else { 0 });
         counts.fill(0);
+        x0s.fill(0);
         let mut definite = Roi::EMPTY;
         for_each_gradient_row(frame, grad, |y, g| {
             if !want_hull {
-                for &v in &g[1..w - 1] {
+                let inner = &g[1..w - 1];
+                // Without lanes, chunks longer than the row leave it all as remainder.
+                let mut pairs = inner.chunks_exact(if lanes { 2 } else { inner.len() + 1 });
+                if lanes {
+                    for pair in &mut pairs {
+                        let (d0, d1) = (pair[0].wrapping_sub(lo), pair[1].wrapping_sub(lo));
+                        if (d0 as usize) < width {
+                            counts[d0 as usize] += 1;
+                        }
+                        if (d1 as usize) < width {
+                            x0s[d1 as usize] += 1;
+                        }
+                    }
+                }
+                for &v in pairs.remainder() {
                     let d = v.wrapping_sub(lo) as usize;
                     if d < width {
                         counts[d] += 1;
@@ -240,11 +260,11 @@ impl Wge {
                 }
                 return;
             }
-            let (mut first, mut last) = (usize::MAX, 0);
-            for (x, &v) in g.iter().enumerate().take(w - 1).skip(1) {
+            let inner = &g[1..w - 1];
+            for (i, &v) in inner.iter().enumerate() {
                 let d = v.wrapping_sub(lo) as usize;
                 if d < width {
-                    let (xs, ys) = (x as u32, y as u32);
+                    let (xs, ys) = (i as u32 + 1, y as u32);
                     if counts[d] == 0 {
                         (x0s[d], x1s[d], yys[d]) = (xs, xs, ys << 16 | ys);
                     } else {
@@ -253,16 +273,18 @@ impl Wge {
                         yys[d] = (yys[d] & 0xFFFF_0000) | ys;
                     }
                     counts[d] += 1;
-                } else if v > hi {
-                    first = first.min(x);
-                    last = x;
                 }
             }
-            if first != usize::MAX {
-                let row = Roi::new(first as u16, y as u16, last as u16 + 1, y as u16 + 1);
+            if let (Some(first), Some(last)) = (first_above(inner, hi), last_above(inner, hi)) {
+                let row = Roi::new(first as u16 + 1, y as u16, last as u16 + 2, y as u16 + 1);
                 definite = definite.hull(&row);
             }
         });
+        if lanes {
+            for (c, &o) in counts.iter_mut().zip(x0s.iter()) {
+                *c += o;
+            }
+        }
         let Some(offset) = counts.iter().position(|&c| {
             below += c;
             below > k
@@ -375,4 +397,35 @@ impl Detector for Wge {
             foreground_px,
         })
     }
+}
+
+/// Width of the blocks [`first_above`] and [`last_above`] test at once.
+const SCAN: usize = 16;
+
+/// Index of the first value above `t`, skipping whole blocks whose maximum is not.
+fn first_above(g: &[u32], t: u32) -> Option<usize> {
+    let mut blocks = g.chunks_exact(SCAN);
+    for (b, block) in (&mut blocks).enumerate() {
+        if block.iter().copied().max().unwrap_or(0) > t {
+            return block.iter().position(|&v| v > t).map(|i| b * SCAN + i);
+        }
+    }
+    let tail = g.len() - blocks.remainder().len();
+    blocks
+        .remainder()
+        .iter()
+        .position(|&v| v > t)
+        .map(|i| tail + i)
+}
+
+/// Index of the last value above `t`, skipping whole blocks whose maximum is not.
+fn last_above(g: &[u32], t: u32) -> Option<usize> {
+    let mut blocks = g.rchunks_exact(SCAN);
+    for (b, block) in (&mut blocks).enumerate() {
+        if block.iter().copied().max().unwrap_or(0) > t {
+            let start = g.len() - (b + 1) * SCAN;
+            return block.iter().rposition(|&v| v > t).map(|i| start + i);
+        }
+    }
+    blocks.remainder().iter().rposition(|&v| v > t)
 }
