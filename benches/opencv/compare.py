@@ -70,7 +70,7 @@ def dog(img, sigma0=4.0, ratio=1.6, levels=7, thr=256):
     small = cv2.resize(img.astype(np.float32), (82, 62), interpolation=cv2.INTER_AREA)
     gs = [cv2.GaussianBlur(small, (0, 0), sigma0 / 4 * ratio ** i, borderType=cv2.BORDER_REPLICATE)
           for i in range(levels)]
-    d = np.stack([(gs[i] - gs[i + 1]) * ratio ** i for i in range(levels - 1)])
+    d = np.stack([(gs[i] - gs[i + 1]) / (ratio - 1) for i in range(levels - 1)])
     mx = np.stack([cv2.dilate(x, np.ones((3, 3), np.uint8)) for x in d])
     mx = np.maximum(mx, np.concatenate([mx[1:], mx[-1:]]))
     mx = np.maximum(mx, np.concatenate([mx[:1], mx[:-1]]))

@@ -18,10 +18,10 @@
 //!
 //! | detector | scratch type | bytes | budget |
 //! |---|---|---|---|
-//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] = 13 288 | 16 KiB |
-//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 12 880 | 16 KiB |
+//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] = 15 208 | 16 KiB |
+//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 11 568 | 16 KiB |
 //! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 344 | 16 KiB |
-//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 71 744 | 96 KiB |
+//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 288 | 96 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in the README.
 #![no_std]
