@@ -38,9 +38,9 @@ fn assert_same_mask(got: &[bool], want: &[bool], w: usize, what: &str) {
 // =================================================================================
 
 /// Checks Otsu on `img` with both box rules: threshold = exhaustive search, mask =
-/// `DN > t`, box = the rule applied to that mask. Returns true (every frame is checked).
+/// `DN > t`, box = the rule applied to that mask.
 #[track_caller]
-fn check_otsu(img: &Img, what: &str) -> bool {
+fn check_otsu(img: &Img, what: &str) {
     let want_t = otsu_expected_threshold(img);
     let want_mask = mask_above(img, want_t);
     for rule in RULES {
@@ -60,7 +60,6 @@ fn check_otsu(img: &Img, what: &str) -> bool {
         let want_box = box_by_rule(rule, &want_mask, img.w, img.h);
         assert_eq!(obs.detection.roi, want_box, "{what}: {rule:?} box");
     }
-    true
 }
 
 #[test]
@@ -80,15 +79,13 @@ fn otsu_reference_agrees_with_a_hand_computation() {
 #[test]
 fn otsu_matches_exhaustive_search_on_small_random_frames() {
     let mut rng = Rng::new(1);
-    let mut checked = 0;
     for case in 0..400 {
         let bits = [1, 2, 5, 8, 9, 10, 12, 14, 14, 16][rng.below(10) as usize];
         let w = rng.urange(1, 48);
         let h = rng.urange(1, 48);
         let img = any_frame(&mut rng, w, h, bits);
-        checked += usize::from(check_otsu(&img, &format!("case {case}")));
+        check_otsu(&img, &format!("case {case}"));
     }
-    assert!(checked >= 350, "only {checked} of 400 frames checked");
 }
 
 #[test]
@@ -101,14 +98,14 @@ fn otsu_matches_exhaustive_search_on_full_frames() {
             2 => uniform_frame(&mut rng, W, H, bits, u16::MAX),
             _ => few_levels_frame(&mut rng, W, H, bits),
         };
-        assert!(check_otsu(&img, &format!("full frame {case}, {bits} bits")));
+        check_otsu(&img, &format!("full frame {case}, {bits} bits"));
     }
 }
 
 #[test]
 fn otsu_matches_exhaustive_search_on_fixture_frames() {
     for (name, img) in fixture_imgs() {
-        assert!(check_otsu(&img, name));
+        check_otsu(&img, name);
     }
 }
 
@@ -132,20 +129,15 @@ fn low_contrast_frames() -> Vec<(String, Img)> {
 }
 
 #[test]
-fn otsu_matches_exhaustive_search_on_low_contrast_frames_across_bins() {
-    // Those that straddle a coarse-bin boundary (the others: the ignored test below).
-    let mut checked = 0;
+fn otsu_matches_exhaustive_search_on_low_contrast_frames_with_both_rules() {
+    // Narrow DN spans: inside one coarse bin or across a boundary.
     for (what, img) in low_contrast_frames() {
-        checked += usize::from(check_otsu(&img, &what));
+        check_otsu(&img, &what);
     }
-    assert!(
-        checked >= 20,
-        "only {checked} frames straddle a bin boundary"
-    );
-    // Straddling by construction: two values either side of a 64-DN boundary.
-    for (lo, hi) in [(63u16, 64u16), (127, 128), (16_319, 16_320)] {
+    // Two values either side of a coarse-bin boundary (128 DN at 14 bits), and inside.
+    for (lo, hi) in [(127u16, 128u16), (255, 256), (63, 64), (16_319, 16_320)] {
         let img = frame_from_pattern(&["#..", ".#.", "..#"], lo, hi);
-        assert!(check_otsu(&img, &format!("{lo}/{hi}")));
+        check_otsu(&img, &format!("{lo}/{hi}"));
     }
 }
 
@@ -250,10 +242,9 @@ fn otsu_pattern_frames() {
 // Adaptive
 // =================================================================================
 
-/// Checks adaptive on `img` with both box rules against the reference. Returns true
-/// (every frame is checked).
+/// Checks adaptive on `img` with both box rules against the reference.
 #[track_caller]
-fn check_adaptive(img: &Img, block: u16, offset: i32, what: &str) -> bool {
+fn check_adaptive(img: &Img, block: u16, offset: i32, what: &str) {
     let want = adaptive_naive(&img.px, img.w, img.h, img.bits, block, offset);
     for rule in RULES {
         let det = Adaptive {
@@ -270,7 +261,6 @@ fn check_adaptive(img: &Img, block: u16, offset: i32, what: &str) -> bool {
         assert_eq!(obs.detection.threshold, offset.max(0) as u32, "{what}");
         assert_box_rule(&det, &obs, img, &what);
     }
-    true
 }
 
 #[test]
@@ -292,7 +282,6 @@ fn adaptive_reference_summed_area_table_equals_literal_loops() {
 #[test]
 fn adaptive_matches_reference_on_small_frames() {
     let mut rng = Rng::new(11);
-    let mut checked = 0;
     let sizes = [
         (1, 1),
         (3, 2),
@@ -308,8 +297,7 @@ fn adaptive_matches_reference_on_small_frames() {
         let img = any_frame(&mut rng, w, h, bits);
         for block in [3, 5, 41, 249] {
             for offset in [-200, -1, 0, 1, 64] {
-                checked +=
-                    usize::from(check_adaptive(&img, block, offset, &format!("case {case}")));
+                check_adaptive(&img, block, offset, &format!("case {case}"));
             }
         }
     }
@@ -323,14 +311,8 @@ fn adaptive_matches_reference_on_small_frames() {
             2 * rng.range(1, w.div_ceil(2) as i64) as u16 + 1
         };
         let offset = rng.range(-2_000, 2_000) as i32;
-        checked += usize::from(check_adaptive(
-            &img,
-            block,
-            offset,
-            &format!("random case {case}"),
-        ));
+        check_adaptive(&img, block, offset, &format!("random case {case}"));
     }
-    assert!(checked >= 400, "only {checked} frames checked");
 }
 
 #[test]
