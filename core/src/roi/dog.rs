@@ -63,7 +63,7 @@ pub struct Dog {
     /// Smallest Gaussian σ, in full-resolution pixels, `≥ 1`. Default 4 (one plane
     /// pixel).
     pub sigma0_px: f32,
-    /// Ratio between consecutive σ, `> 1` (default 1.6, as Lowe and scikit-image).
+    /// Ratio between consecutive σ, `≥ 1.001` (default 1.6, as Lowe and scikit-image).
     pub sigma_ratio: f32,
     /// Gaussian levels, 3..=[`MAX_LEVELS`] (default 7: σ = 4 … 67 px, blobs of
     /// half-side 6 … 95 px).
@@ -257,10 +257,12 @@ impl Detector for Dog {
                 expected: "a finite sigma of at least 1 pixel",
             });
         }
-        if !(self.sigma_ratio.is_finite() && self.sigma_ratio > 1.0) {
+        // At least 1.001 keeps the response, (G_i − G_{i+1})·16/(k − 1) ≤ 65 535 · 16 000,
+        // inside an i32.
+        if !(self.sigma_ratio.is_finite() && self.sigma_ratio >= 1.001) {
             return Err(DetectError::InvalidParameter {
                 name: "sigma_ratio",
-                expected: "a finite ratio above 1",
+                expected: "a finite ratio of at least 1.001",
             });
         }
         if self.levels < 3 || self.levels > MAX_LEVELS {
@@ -440,8 +442,7 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
     let layers_total = levels - 1;
     // G(kσ) − G(σ) ≈ (k − 1)·σ²∇²G: the difference is already scale-normalised; only
     // the constant 1/(k − 1) remains, so that responses read as σ²∇²G in DN.
-    let norm = [libm::roundf(NORM_Q as f32 / (dog.sigma_ratio - 1.0)).max(1.0) as i32;
-        MAX_LEVELS as usize];
+    let norm = libm::roundf(NORM_Q as f32 / (dog.sigma_ratio - 1.0)).max(1.0) as i32;
     let min_response = i32::try_from(dog.min_response_dn)
         .unwrap_or(i32::MAX)
         .saturating_mul(NORM_Q);
@@ -459,12 +460,12 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
             blob_count,
             ..
         } = &mut *work;
-        // Layer l is (G_l − G_{l+1})·norm_l; its two planes come from the ring.
+        // Layer l is (G_l − G_{l+1})·norm; its two planes come from the ring.
         let planes = |l: u8| {
             (
                 &ring[usize::from(l) % 4][..n],
                 &ring[usize::from(l + 1) % 4][..n],
-                norm[usize::from(l)],
+                norm,
             )
         };
         let response = |(a, b, k): (&[u16], &[u16], i32), idx: usize| {
@@ -550,6 +551,24 @@ mod tests {
     /// the border (one σ and more) the two agree within 0.2 % of the plane's DN range;
     /// nearer the border they differ because the replicated border enters twice (at the
     /// level that is halved and again on the half plane), by under 3 % in a corner.
+    #[test]
+    fn ratios_too_close_to_one_are_refused() {
+        let near_one = Dog {
+            sigma_ratio: 1.0005,
+            ..Dog::default()
+        };
+        assert!(near_one.validate().is_err());
+        let smallest = Dog {
+            sigma_ratio: 1.001,
+            sigma0_px: 1.0,
+            ..Dog::default()
+        };
+        assert_eq!(smallest.validate(), Ok(()));
+        // The largest response still fits: a full-scale step between two levels.
+        let norm = libm::roundf(NORM_Q as f32 / (smallest.sigma_ratio - 1.0)) as i64;
+        assert!(65_535 * norm <= i64::from(i32::MAX));
+    }
+
     #[test]
     fn decimated_levels_match_direct_blur() {
         let dog = Dog::default();
