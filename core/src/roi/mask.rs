@@ -79,9 +79,11 @@ pub struct RoiBuilder {
     foreground_px: u32,
     /// [`BoxRule::AllForeground`]: the hull of all foreground pixels.
     hull: Roi,
-    prev: [Run; MAX_RUNS],
+    /// The runs of the previous and of the current row, alternately (`cur_side`
+    /// says which is current, so finishing a row swaps an index, not the arrays).
+    runs: [[Run; MAX_RUNS]; 2],
+    cur_side: usize,
     prev_len: usize,
-    cur: [Run; MAX_RUNS],
     cur_len: usize,
     table: [Component; MAX_COMPONENTS],
     /// One past the highest table entry in use.
@@ -104,9 +106,9 @@ impl RoiBuilder {
             next_row: 0,
             foreground_px: 0,
             hull: Roi::EMPTY,
-            prev: [NO_RUN; MAX_RUNS],
+            runs: [[NO_RUN; MAX_RUNS]; 2],
+            cur_side: 0,
             prev_len: 0,
-            cur: [NO_RUN; MAX_RUNS],
             cur_len: 0,
             table: [FREE_COMPONENT; MAX_COMPONENTS],
             table_high: 0,
@@ -184,7 +186,7 @@ impl RoiBuilder {
         self.collect_runs(x0, mask);
         self.link_runs(y);
         self.retire(y);
-        core::mem::swap(&mut self.prev, &mut self.cur);
+        self.cur_side = 1 - self.cur_side;
         self.prev_len = self.cur_len;
         self.cur_len = 0;
     }
@@ -202,7 +204,7 @@ impl RoiBuilder {
             while x < mask.len() && mask[x] {
                 x += 1;
             }
-            if let Some(run) = self.cur.get_mut(self.cur_len) {
+            if let Some(run) = self.runs[self.cur_side].get_mut(self.cur_len) {
                 *run = Run {
                     x0: (x0 + start) as u16,
                     x1: (x0 + x) as u16,
@@ -217,17 +219,18 @@ impl RoiBuilder {
     /// the 8-connected runs above it, or a new one.
     fn link_runs(&mut self, y: usize) {
         let mut j0 = 0;
+        let (c, p) = (self.cur_side, 1 - self.cur_side);
         for i in 0..self.cur_len {
-            let run = self.cur[i];
+            let run = self.runs[c][i];
             // Runs above that end left of this run's left neighbour can no longer touch
             // this or any later run.
-            while j0 < self.prev_len && self.prev[j0].x1 < run.x0 {
+            while j0 < self.prev_len && self.runs[p][j0].x1 < run.x0 {
                 j0 += 1;
             }
             let mut label = FREE;
             let mut j = j0;
-            while j < self.prev_len && self.prev[j].x0 <= run.x1 {
-                let root = self.find(self.prev[j].label);
+            while j < self.prev_len && self.runs[p][j].x0 <= run.x1 {
+                let root = self.find(self.runs[p][j].label);
                 label = if label == FREE {
                     root
                 } else {
@@ -245,12 +248,12 @@ impl RoiBuilder {
                 }
             }
             let width = self.width as u32;
-            let c = &mut self.table[usize::from(label)];
+            let comp = &mut self.table[usize::from(label)];
             let run_roi = Roi::new(run.x0, y as u16, run.x1, y as u16 + 1);
-            c.roi = c.roi.hull(&run_roi);
-            c.area += u32::from(run.x1 - run.x0);
-            c.first = c.first.min(y as u32 * width + u32::from(run.x0));
-            self.cur[i].label = label;
+            comp.roi = comp.roi.hull(&run_roi);
+            comp.area += u32::from(run.x1 - run.x0);
+            comp.first = comp.first.min(y as u32 * width + u32::from(run.x0));
+            self.runs[c][i].label = label;
         }
     }
 
@@ -258,9 +261,10 @@ impl RoiBuilder {
     /// root of a current run; roots no current run reaches are complete components.
     fn retire(&mut self, y: usize) {
         let stamp = y as u16;
+        let c = self.cur_side;
         for i in 0..self.cur_len {
-            let root = self.find(self.cur[i].label);
-            self.cur[i].label = root;
+            let root = self.find(self.runs[c][i].label);
+            self.runs[c][i].label = root;
             if let Some(c) = self.table.get_mut(usize::from(root)) {
                 c.seen_row = stamp;
             }
