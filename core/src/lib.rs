@@ -3,8 +3,11 @@
 //! The flight core of tirroi: `#![no_std]`, no heap, bounded memory known at compile
 //! time. It holds what a thermal-infrared (TIR) camera and the first image-processing
 //! step of a spacecraft's guidance, navigation and control (GNC) chain do on board:
-//! region-of-interest (ROI) detection on 328×248 frames of digital numbers (DN).
+//! the camera model (radiance → DN → noisy frame) and region-of-interest (ROI)
+//! detection on 328×248 frames of digital numbers (DN).
 //!
+//! - [`sensor`]: the camera model of the paper's Sections 3.1 and 3.3: response, band
+//!   radiance, view-factor flux, DN conversion, noise, and the frame pass.
 //! - [`frame`]: a validated, borrowed view of a DN frame ([`Frame`]).
 //! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface and the four detectors
 //!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`].
@@ -30,6 +33,7 @@
 
 pub mod frame;
 pub mod roi;
+pub mod sensor;
 
 pub use frame::{Frame, FrameError};
 pub use roi::{BoxRule, DetectError, Detection, Detector, Method, Roi};

@@ -1,0 +1,79 @@
+//! One pass from a frame of signal to the noisy camera frame of DN (Eq. 18):
+//! DN_camera = quantise(a·s + b + noise), row by row, with no buffer beyond the output.
+//!
+//! The noise is added before quantisation, as the A/D converter sees the analog noise;
+//! quantising first and adding sub-DN noise afterwards would need a second rounding and
+//! would erase the `PaperLiteral` level entirely instead of dithering it.
+
+use super::SensorError;
+use super::dn::DnMapping;
+use super::noise::NoiseField;
+use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+
+/// Converts `signal` (row-major, `width` columns: F(T) in W m⁻² for radiometry mode, q_fc
+/// in W m⁻² for detection mode) to DN in `out` through `mapping`, adding `noise` when
+/// given (skipped when it is silent), quantising with saturation (NaN signal gives 0).
+///
+/// # Errors
+/// [`SensorError::BadSize`] when `width` is 0 or above 328, `signal` and `out` differ in
+/// length or are not whole rows, there are more than 248 rows, or the noise field's width
+/// differs.
+pub fn expose_frame(
+    signal: &[f32],
+    width: usize,
+    mapping: &DnMapping,
+    noise: Option<&mut NoiseField>,
+    out: &mut [u16],
+) -> Result<(), SensorError> {
+    if width == 0 || width > FRAME_WIDTH {
+        return Err(SensorError::BadSize {
+            name: "width",
+            actual: width,
+            expected: FRAME_WIDTH,
+        });
+    }
+    if out.len() != signal.len() {
+        return Err(SensorError::BadSize {
+            name: "out",
+            actual: out.len(),
+            expected: signal.len(),
+        });
+    }
+    if signal.len() % width != 0 || signal.len() / width > FRAME_HEIGHT {
+        return Err(SensorError::BadSize {
+            name: "signal",
+            actual: signal.len(),
+            expected: width * FRAME_HEIGHT,
+        });
+    }
+    let gain = mapping.gain_dn() as f32;
+    // + 0.5 folds the rounding of `quantise` into the offset.
+    let offset = mapping.offset_dn() as f32 + 0.5;
+    let max = u32::from(mapping.max_dn());
+    let quantise = |dn: f32| (dn as u32).min(max) as u16;
+    let rows = signal.chunks_exact(width).zip(out.chunks_exact_mut(width));
+    match noise.filter(|n| !n.is_silent()) {
+        None => {
+            for (s_row, o_row) in rows {
+                for (o, &s) in o_row.iter_mut().zip(s_row) {
+                    *o = quantise(gain * s + offset);
+                }
+            }
+        }
+        Some(field) => {
+            if field.width() != width {
+                return Err(SensorError::BadSize {
+                    name: "noise width",
+                    actual: field.width(),
+                    expected: width,
+                });
+            }
+            for (s_row, o_row) in rows {
+                for ((o, &s), n) in o_row.iter_mut().zip(s_row).zip(field.next_row()) {
+                    *o = quantise(gain * s + offset + n);
+                }
+            }
+        }
+    }
+    Ok(())
+}
