@@ -33,6 +33,9 @@ struct Interval {
     ln_l: f32,
     /// L(T_i) in f32 (0 or subnormal below 13 K), W m⁻² sr⁻¹.
     l: f32,
+    /// L(T_i+1) in f32, W m⁻² sr⁻¹: with `l`, the clamp that keeps the result
+    /// monotone across nodes despite rounding.
+    l_next: f32,
     /// ln L(T_i+1) − ln L(T_i), taken in f64 before rounding.
     dln_l: f32,
     /// d ln L/du at u = 0 (u = (T − T_i)/(T_i+1 − T_i)).
@@ -41,7 +44,7 @@ struct Interval {
     slope1: f32,
 }
 
-/// The fast band-radiance table for one response: 352 intervals, 9 856 bytes
+/// The fast band-radiance table for one response: 352 intervals, 11 264 bytes
 /// (`size_of::<BandLut>()`), built from the exact f64 path.
 #[derive(Debug, Clone)]
 pub struct BandLut {
@@ -73,6 +76,7 @@ impl BandLut {
                 inv_width_k: (1.0 / h) as f32,
                 ln_l: libm::log(l0) as f32,
                 l: l0 as f32,
+                l_next: l1 as f32,
                 dln_l: (libm::log(l1) - libm::log(l0)) as f32,
                 slope0: (d0 / l0 * h) as f32,
                 slope1: (d1 / l1 * h) as f32,
@@ -133,6 +137,25 @@ impl BandLut {
         } else {
             libm::expf(iv.ln_l + dy)
         };
+        // The true L lies between the two correctly rounded node values; clamping to
+        // them only removes error, and makes the end of one interval meet the start
+        // of the next without a one-ulp step down.
+        let l = if u <= 1.0 {
+            l.clamp(iv.l, iv.l_next)
+        } else {
+            l.max(iv.l_next)
+        };
         Ok(e * l)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_size_is_as_documented() {
+        assert_eq!(core::mem::size_of::<BandLut>(), 11_264);
+        assert_eq!(LUT_INTERVALS, 352);
     }
 }

@@ -61,7 +61,8 @@ impl DnMapping {
     /// `offset_dn` (b, DN), quantised to `bits` (1..=16).
     ///
     /// # Errors
-    /// [`SensorError`] for a gain that is not finite and > 0, a non-finite offset, or a
+    /// [`SensorError`] for a gain that is not finite and ≥ 2.2e-308 (a normal f64, so
+    /// that 1/a is finite), a non-finite offset, or a
     /// bit depth outside 1..=16.
     pub fn new(gain_dn: f64, offset_dn: f64, bits: u8) -> Result<Self, SensorError> {
         check_positive("gain_dn", gain_dn)?;

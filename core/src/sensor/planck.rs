@@ -42,6 +42,10 @@ pub const STEFAN_BOLTZMANN_W_M2_K4: f64 = 5.670_374_419_184_429e-8;
 /// 5000 K; above that only finiteness and monotonicity are.
 pub const T_MAX_K: f64 = 10_000.0;
 
+/// Below this temperature the f32 paths return 0 (L < 1e-408, and 1/T overflows f32
+/// for subnormal T), K.
+const F32_ZERO_BELOW_K: f32 = 1.0;
+
 /// Gauss–Legendre nodes (positive half, on [−1, 1]) and weights, 10 points, to 20
 /// digits (mpmath; Abramowitz & Stegun Table 25.4). The digits beyond f64 are kept so
 /// the table can be checked against its sources.
@@ -245,7 +249,12 @@ impl BandRadiance {
             .zip(&self.weight[..self.nodes])
         {
             let x = x_t * inv_t;
-            sum += w * x / (libm::expm1(x) * -libm::expm1(-x));
+            let em = libm::expm1(x);
+            // Past exp overflow (x > 709.8) the term is below 1e-300: drop it rather
+            // than form ∞/∞.
+            if em.is_finite() {
+                sum += w * x / (em * -libm::expm1(-x));
+            }
         }
         sum * inv_t
     }
@@ -316,14 +325,15 @@ impl BandRadiance {
     ///
     /// Same quadrature, with the common factor e^(−c₂/λ_max T) pulled out so that no
     /// term goes subnormal before the sum does; relative error ≤ 1e-5 from 13 K
-    /// (where L reaches the f32 normal range) to 5000 K.
+    /// (where L reaches the f32 normal range) to 5000 K. Exactly 0 below 1 K, where
+    /// L < 1e-408.
     ///
     /// # Errors
     /// As [`BandRadiance::radiance_w_m2_sr`].
     pub fn radiance_f32(&self, t_k: f32, emissivity: f32) -> Result<f32, SensorError> {
         let t = check_temperature(t_k as f64)? as f32;
         let e = check_emissivity(emissivity as f64)? as f32;
-        if t <= 0.0 {
+        if t < F32_ZERO_BELOW_K {
             return Ok(0.0);
         }
         let (sum, x_min) = self.scaled_sum_f32(t);
@@ -331,18 +341,19 @@ impl BandRadiance {
     }
 
     /// ln of the blackbody band radiance (ε = 1) in f32, ln(W m⁻² sr⁻¹): finite for every
-    /// T > 0 K even where L itself is below the f32 range (below 13 K), with an absolute
+    /// T ≥ 1 K even where L itself is below the f32 range (below 13 K), with an absolute
     /// error below 1e-4 from 3 K to 5000 K.
     ///
     /// # Errors
-    /// As [`BandRadiance::radiance_w_m2_sr`], and for T = 0 (ln 0 is −∞).
+    /// As [`BandRadiance::radiance_w_m2_sr`], and for T < 1 K (ln L < −930 there, and
+    /// c₂/λT leaves the f32 range for subnormal T).
     pub fn ln_radiance_f32(&self, t_k: f32) -> Result<f32, SensorError> {
         let t = check_range(
             "t_k",
             t_k as f64,
-            f64::MIN_POSITIVE,
+            f64::from(F32_ZERO_BELOW_K),
             T_MAX_K,
-            "0 < t_k <= 10000 K",
+            "1 K <= t_k <= 10000 K",
         )? as f32;
         let (sum, x_min) = self.scaled_sum_f32(t);
         Ok(libm::logf(sum) - x_min)
@@ -496,6 +507,13 @@ mod tests {
         * core::f64::consts::PI
         * core::f64::consts::PI
         / 15.0;
+
+    #[test]
+    fn size_is_as_documented() {
+        // 240 nodes × (8 + 8 + 4 + 4) bytes plus the response and the flat constant.
+        let size = core::mem::size_of::<BandRadiance>();
+        assert!((5_760..6_000).contains(&size), "{size}");
+    }
 
     #[test]
     fn tir_model_needs_17_panels() {
