@@ -10,6 +10,7 @@ use tirroi_core::{BoxRule, Method};
 
 use crate::image_io::read_frame;
 use crate::run::DetectorBank;
+use crate::sensor_view::{self, SensorRequest};
 use crate::{figure, fixture};
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
@@ -68,6 +69,105 @@ pub enum Command {
         #[arg(long)]
         figures: Option<PathBuf>,
     },
+    /// Print the thermal camera model: noise budget, noise voltage density, and the
+    /// band radiance, emissive power, radiometry DN and T_rad of scene temperatures.
+    ///
+    /// Every number comes from `tirroi_core::sensor` (Table 1 bolometer, Eqs. 1-17).
+    /// Bad input prints one line `tirroi: error: ...` and exits with code 2.
+    ///
+    /// With --json, one JSON object on stdout:
+    ///   {"response":"tir"|"flat", "level":"netd"|"paper-literal"|"paper-visible",
+    ///    "netd_k":0.4, "t_ref_k":300, "bits":14, "emissivity":1,
+    ///    "mapping":{"t_lo_k","t_hi_k","f_min_w_m2","f_max_w_m2","gain_dn_per_w_m2",
+    ///               "offset_dn","max_dn"},
+    ///    "noise":{"reading":"table2"|"as-printed"|"physical",
+    ///             "johnson_v","flicker_v","thermal_v","total_v",          (V)
+    ///             "johnson_dn","flicker_dn","thermal_dn","total_dn",      (DN, chosen level)
+    ///             "dn_per_k", "netd_equivalent_k",                        (DN/K, K)
+    ///             "levels":[{"level","total_dn","netd_equivalent_k"}]},   (every level)
+    ///    "nvd":[{"bandwidth_hz","nvd_v_per_sqrt_hz"}],
+    ///    "temperatures":[{"t_k","radiance_w_m2_sr","emissive_power_w_m2",
+    ///                     "sigma_t4_over_pi_w_m2_sr","dn","saturated","t_rad_k"}]}
+    #[command(verbatim_doc_comment)]
+    Sensor(SensorArgs),
+}
+
+/// The options of `tirroi sensor`. They are taken as text and checked by
+/// [`sensor_view::report`], so that every bad value gets the same one-line error.
+#[derive(Debug, clap::Args)]
+pub struct SensorArgs {
+    /// Noise level of the sigma in DN: netd (total sigma = NETD (K) x dDN/dT (DN/K) at
+    /// --t-ref-k), paper-literal (Eq. 16: 2470 ADU/V x RMS (V)), paper-visible (Eq. 16 x
+    /// (2^bits - 1)).
+    #[arg(long, value_name = "LEVEL", default_value = "netd")]
+    pub level: String,
+    /// NETD of the `netd` level, K.
+    #[arg(
+        long,
+        value_name = "K",
+        default_value = "0.4",
+        allow_hyphen_values = true
+    )]
+    pub netd_k: String,
+    /// Reference scene temperature of the `netd` level (where dDN/dT is taken), K.
+    #[arg(
+        long,
+        value_name = "K",
+        default_value = "300",
+        allow_hyphen_values = true
+    )]
+    pub t_ref_k: String,
+    /// RMS voltages (V) of the three noise sources: table2 (the published Table 2),
+    /// as-printed (Eqs. 11, 13, 14 as printed), physical (consistent bandwidths).
+    #[arg(long, value_name = "READING", default_value = "table2")]
+    pub reading: String,
+    /// Bit depth of the DN, 1..=16.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value = "14",
+        allow_hyphen_values = true
+    )]
+    pub bits: String,
+    /// Scene temperatures, K, comma-separated (0..=10000).
+    #[arg(
+        long,
+        value_name = "K,K,...",
+        default_value = "150,200,250,300,350,400,460",
+        allow_hyphen_values = true
+    )]
+    pub temps: String,
+    /// Gray-body emissivity of the scene (and of the range), 0 < emissivity <= 1.
+    #[arg(
+        long,
+        value_name = "E",
+        default_value = "1.0",
+        allow_hyphen_values = true
+    )]
+    pub emissivity: String,
+    /// Radiometry auto range (Eq. 17), K: F(T_lo) maps to DN 0, F(T_hi) to 2^bits - 1.
+    #[arg(
+        long,
+        value_name = "T_LO,T_HI",
+        default_value = "150,460",
+        allow_hyphen_values = true
+    )]
+    pub range_k: String,
+    /// Measurement bandwidths of the noise voltage density, Hz, comma-separated (> 0).
+    #[arg(
+        long,
+        value_name = "HZ,HZ,...",
+        default_value = "1,10,100,1000,10000,83333,1000000",
+        allow_hyphen_values = true
+    )]
+    pub bandwidths: String,
+    /// Spectral response: tir (the Hayabusa2 TIR band model, 8-12 um) or flat (R = 1, so
+    /// that i = emissivity x sigma T^4/pi (W m^-2 sr^-1)).
+    #[arg(long, value_name = "RESPONSE", default_value = "tir")]
+    pub response: String,
+    /// Print one JSON object (shape in `tirroi sensor --help`) instead of the tables.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// One method or all of them.
@@ -122,7 +222,44 @@ pub fn main() -> ExitCode {
                 ExitCode::from(EXIT_BAD_INPUT)
             }
         },
+        Command::Sensor(args) => sensor(&args),
     }
+}
+
+fn sensor(args: &SensorArgs) -> ExitCode {
+    let request = SensorRequest {
+        level: &args.level,
+        reading: &args.reading,
+        response: &args.response,
+        netd_k: &args.netd_k,
+        t_ref_k: &args.t_ref_k,
+        bits: &args.bits,
+        temps: &args.temps,
+        emissivity: &args.emissivity,
+        range_k: &args.range_k,
+        bandwidths: &args.bandwidths,
+    };
+    let report = match sensor_view::report(&request) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("tirroi: error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let text = if args.json {
+        match serde_json::to_string(&report) {
+            Ok(s) => s + "\n",
+            Err(e) => {
+                eprintln!("tirroi: error: cannot write JSON: {e}");
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
+        }
+    } else {
+        report.markdown()
+    };
+    // A closed stdout (e.g. piped into `head`) is not an error worth a panic.
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    ExitCode::SUCCESS
 }
 
 fn detect(

@@ -10,3 +10,5 @@ pub mod figure;
 pub mod fixture;
 pub mod image_io;
 pub mod run;
+/// `tirroi sensor`: the thermal camera model of `tirroi_core::sensor` as tables or JSON.
+pub mod sensor_view;
