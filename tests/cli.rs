@@ -1,9 +1,11 @@
 //! The `tirroi` binary end to end: fixtures on disk, `detect --json` lines that agree
 //! with the library, and one clean error line (exit code 2, no panic) per bad file.
 
+mod cli_common;
+
+use cli_common::run;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::OnceLock;
+use std::process::Output;
 
 use serde_json::Value;
 use tirroi::core::roi::adaptive::Adaptive;
@@ -13,53 +15,6 @@ use tirroi::core::roi::wge::Wge;
 use tirroi::core::{Detection, Detector, Method, Roi};
 use tirroi::host::fixture;
 use tirroi::host::image_io::read_frame;
-
-/// The `tirroi` binary of this build (the root package cannot use
-/// `CARGO_BIN_EXE_tirroi`: the binary belongs to `tirroi-host`). It lives next to
-/// this test's `deps/` directory; cargo is asked once to bring it up to date (a no-op
-/// when it is), so a stale binary is never tested.
-fn tirroi() -> &'static Path {
-    static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| {
-        let exe = std::env::current_exe().expect("test executable path");
-        let profile_dir = exe
-            .parent()
-            .and_then(Path::parent)
-            .expect("test executables live in <target>/<profile>/deps");
-        let bin = profile_dir.join(format!("tirroi{}", std::env::consts::EXE_SUFFIX));
-        let target_dir = profile_dir.parent().expect("<target>/<profile>");
-        let profile = profile_dir
-            .file_name()
-            .and_then(|p| p.to_str())
-            .unwrap_or("debug");
-        let mut build = Command::new(env!("CARGO"));
-        build
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args(["build", "-q", "-p", "tirroi-host", "--bin", "tirroi"])
-            .arg("--target-dir")
-            .arg(target_dir);
-        match profile {
-            "debug" => {}
-            "release" => {
-                build.arg("--release");
-            }
-            other => {
-                build.args(["--profile", other]);
-            }
-        }
-        let status = build.status().expect("run cargo build");
-        assert!(status.success(), "cargo build of the tirroi binary failed");
-        assert!(bin.is_file(), "no binary at {}", bin.display());
-        bin
-    })
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(tirroi())
-        .args(args)
-        .output()
-        .expect("run tirroi")
-}
 
 fn stdout_lines(out: &Output) -> Vec<String> {
     String::from_utf8(out.stdout.clone())

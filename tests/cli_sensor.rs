@@ -2,59 +2,13 @@
 //! flat response, Table 2, the NETD level, the DN round trip), and every bad option is
 //! one clean error line (exit code 2, no panic).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::OnceLock;
+mod cli_common;
+
+use cli_common::run;
+use std::process::Output;
 
 use serde_json::Value;
 use tirroi::core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
-
-/// The `tirroi` binary of this build, located as in tests/cli.rs (the root package
-/// cannot use `CARGO_BIN_EXE_tirroi`: the binary belongs to `tirroi-host`). It lives
-/// next to this test's `deps/` directory; cargo is asked once to bring it up to date
-/// (a no-op when it is), so a stale binary is never tested.
-fn tirroi() -> &'static Path {
-    static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| {
-        let exe = std::env::current_exe().expect("test executable path");
-        let profile_dir = exe
-            .parent()
-            .and_then(Path::parent)
-            .expect("test executables live in <target>/<profile>/deps");
-        let bin = profile_dir.join(format!("tirroi{}", std::env::consts::EXE_SUFFIX));
-        let target_dir = profile_dir.parent().expect("<target>/<profile>");
-        let profile = profile_dir
-            .file_name()
-            .and_then(|p| p.to_str())
-            .unwrap_or("debug");
-        let mut build = Command::new(env!("CARGO"));
-        build
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args(["build", "-q", "-p", "tirroi-host", "--bin", "tirroi"])
-            .arg("--target-dir")
-            .arg(target_dir);
-        match profile {
-            "debug" => {}
-            "release" => {
-                build.arg("--release");
-            }
-            other => {
-                build.args(["--profile", other]);
-            }
-        }
-        let status = build.status().expect("run cargo build");
-        assert!(status.success(), "cargo build of the tirroi binary failed");
-        assert!(bin.is_file(), "no binary at {}", bin.display());
-        bin
-    })
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(tirroi())
-        .args(args)
-        .output()
-        .expect("run tirroi")
-}
 
 fn stderr_text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()

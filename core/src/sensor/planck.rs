@@ -107,16 +107,7 @@ impl BandRadiance {
     /// [`SensorError`] for a band model whose parameters do not validate, or whose band
     /// needs more than [`MAX_PANELS`] panels (wider than about 20 µm).
     pub fn new(response: &CameraResponse) -> Result<Self, SensorError> {
-        let mut me = BandRadiance {
-            response: *response,
-            flat_w_m2_sr_k4: None,
-            nodes: 0,
-            x_t_k: [0.0; MAX_NODES],
-            weight: [0.0; MAX_NODES],
-            x_min_t_k32: 0.0,
-            dx_t_k32: [0.0; MAX_NODES],
-            weight32: [0.0; MAX_NODES],
-        };
+        let mut me = Self::empty(*response);
         match response {
             CameraResponse::Flat => {
                 me.flat_w_m2_sr_k4 = Some(flat_integral() * C1_W_UM4_M2_SR / c2_pow4());
@@ -124,6 +115,20 @@ impl BandRadiance {
             CameraResponse::Band(bell) => me.fill_band(bell)?,
         }
         Ok(me)
+    }
+
+    /// A model with no nodes yet (radiance 0 until filled).
+    fn empty(response: CameraResponse) -> Self {
+        BandRadiance {
+            response,
+            flat_w_m2_sr_k4: None,
+            nodes: 0,
+            x_t_k: [0.0; MAX_NODES],
+            weight: [0.0; MAX_NODES],
+            x_min_t_k32: 0.0,
+            dx_t_k32: [0.0; MAX_NODES],
+            weight32: [0.0; MAX_NODES],
+        }
     }
 
     /// The Hayabusa2 TIR model with η = 1 ([`SkewedBell::HAYABUSA2_TIR`]).
@@ -485,16 +490,9 @@ fn flat_integral() -> f64 {
 /// stays small; returns an empty (flat) model instead of panicking.
 #[cold]
 fn unreachable_band() -> BandRadiance {
-    BandRadiance {
-        response: CameraResponse::Flat,
-        flat_w_m2_sr_k4: Some(STEFAN_BOLTZMANN_W_M2_K4 / core::f64::consts::PI),
-        nodes: 0,
-        x_t_k: [0.0; MAX_NODES],
-        weight: [0.0; MAX_NODES],
-        x_min_t_k32: 0.0,
-        dx_t_k32: [0.0; MAX_NODES],
-        weight32: [0.0; MAX_NODES],
-    }
+    let mut flat = BandRadiance::empty(CameraResponse::Flat);
+    flat.flat_w_m2_sr_k4 = Some(STEFAN_BOLTZMANN_W_M2_K4 / core::f64::consts::PI);
+    flat
 }
 
 #[cfg(test)]
