@@ -27,6 +27,16 @@
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 288 | 96 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in the README.
+//!
+//! ## Memory of the camera model
+//!
+//! | piece | bytes |
+//! |---|---|
+//! | [`sensor::BandRadiance`] (170 quadrature nodes in f64 and f32; room for 240) | 5 872 |
+//! | [`sensor::BandLut`] (the fast path's 352 intervals) | 11 264 |
+//! | [`sensor::NoiseField`] (generator, one row of 1/f filter state) | 1 360 |
+//!
+//! The frame pass [`sensor::expose_frame`] needs nothing beyond its input and output.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

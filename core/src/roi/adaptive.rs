@@ -1,4 +1,4 @@
-//! Adaptive thresholding (paper ref. [48]): a pixel is foreground when it exceeds the
+//! Adaptive thresholding (paper ref. \[48\]): a pixel is foreground when it exceeds the
 //! mean of the square block around it by an offset.
 //!
 //! The block mean is exact: the block is `block × block` pixels centred on the pixel

@@ -1,4 +1,4 @@
-//! Difference-of-Gaussians (DoG) blob detection (Lindeberg / Lowe, paper ref. [49]).
+//! Difference-of-Gaussians (DoG) blob detection (Lindeberg / Lowe, paper ref. \[49\]).
 //!
 //! 1. The frame is averaged over [`DOWNSAMPLE`]×[`DOWNSAMPLE`] blocks (82×62 pixels for
 //!    a reference frame): the target at 15–440 m spans 9–150 full pixels, so the

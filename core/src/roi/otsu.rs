@@ -1,4 +1,4 @@
-//! Otsu's global threshold (Otsu 1979, paper ref. [47]), exact on the full bit depth.
+//! Otsu's global threshold (Otsu 1979, paper ref. \[47\]), exact on the full bit depth.
 //!
 //! The threshold `t` splits the DN into a background class `v ≤ t` and a foreground
 //! class `v > t`; Otsu's choice maximises the between-class variance

@@ -1,5 +1,5 @@
 //! Weak gradient elimination (WGE) of the Sharma–Ventura–D'Amico (SVD) architecture
-//! (paper ref. [4]): keep the pixels of strongest gradient, box what remains.
+//! (paper ref. \[4\]): keep the pixels of strongest gradient, box what remains.
 //!
 //! The gradient is the Prewitt operator, its magnitude the L1 norm
 //! `g = |g_x| + |g_y|` (integers, ≤ 6·max_dn), on interior pixels only (the one-pixel

@@ -53,16 +53,16 @@ use crate::frame::FRAME_WIDTH;
 
 /// Boltzmann constant k_B, J K⁻¹ (SI 2019 exact).
 pub const BOLTZMANN_J_K: f64 = 1.380_649e-23;
-/// A/D gain G_A/D of Eq. 16, ADU per volt (paper ref. [46]).
+/// A/D gain G_A/D of Eq. 16, ADU per volt (paper ref. \[46\]).
 pub const ADC_GAIN_ADU_PER_V: f64 = 2470.0;
 /// NETD of the Hayabusa2 TIR, K: ≤ 0.4 K per pixel in the calibrated range (Okada et
 /// al. 2017, Space Sci. Rev. 208:255).
 pub const TIR_NETD_K: f64 = 0.4;
-/// Default correlation length of the 1/f map, pixels (the paper's ref. [11] filter is
+/// Default correlation length of the 1/f map, pixels (the paper's ref. \[11\] filter is
 /// not specified; 4 px gives the blotchy texture of Fig. 5's flicker panel).
 pub const DEFAULT_FLICKER_CORRELATION_PX: f32 = 4.0;
 
-/// The microbolometer parameters of paper Table 1 (refs. [41, 42]).
+/// The microbolometer parameters of paper Table 1 (refs. \[41, 42\]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BolometerParams {
     /// Bolometer temperature T_B, K: 300.
@@ -345,7 +345,7 @@ impl NoiseSigmas {
     }
 }
 
-/// A seeded noise map in DN, produced one row at a time (module docs). 1.3 KiB.
+/// A seeded noise map in DN, produced one row at a time (module docs). 1 360 bytes.
 #[derive(Debug, Clone)]
 pub struct NoiseField {
     rng: Xoshiro128pp,

@@ -1,6 +1,6 @@
 //! The camera response R(λ) = η·R_L(λ)·R_F(λ) of paper Eq. 3.
 //!
-//! The paper fits "skewed bell-shaped curves" to the Hayabusa2 TIR data of its ref. [33]
+//! The paper fits "skewed bell-shaped curves" to the Hayabusa2 TIR data of its ref. \[33\]
 //! (Fig. 1) without printing the numbers. [`SkewedBell::HAYABUSA2_TIR`] adopts the model
 //! of the project's shared reference (`shared/reference/REFERENCE.md`, §3), a rounded
 //! least-squares fit to the measured TIR curve: a logistic rise (the lens and filter
