@@ -6,9 +6,12 @@
 #![deny(missing_docs)]
 
 pub mod cli;
+pub mod earth;
 pub mod figure;
 pub mod fixture;
+pub mod geom;
 pub mod image_io;
 pub mod run;
 /// `tirroi sensor`: the thermal camera model of `tirroi_core::sensor` as tables or JSON.
 pub mod sensor_view;
+pub mod target;
