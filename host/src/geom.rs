@@ -69,7 +69,7 @@ impl Rotation {
     /// gives the identity).
     pub fn from_quaternion(q: [f64; 4]) -> Rotation {
         let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-        if !(n > 0.0) {
+        if n.is_nan() || n <= 0.0 {
             return Rotation::IDENTITY;
         }
         let [w, x, y, z] = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
