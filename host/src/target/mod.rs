@@ -3,6 +3,10 @@
 
 pub mod mesh;
 pub mod models;
+pub mod thermal;
 
 pub use mesh::{Material, Mesh, Part};
 pub use models::{MaterialCase, cube_cylinder, tango};
+pub use thermal::{
+    ThermalEnvironment, ThermalError, ThermalNetwork, ThermalSolution, solve_steady_state,
+};
