@@ -174,8 +174,8 @@ fn tango_parts_sizes_and_closure() {
             "patch-antennas"
         ]
     );
-    for p in 0..mesh.parts.len() {
-        assert!(mesh.facets_of_part(p).count() > 0, "{}", names[p]);
+    for (p, name) in names.iter().enumerate() {
+        assert!(mesh.facets_of_part(p).count() > 0, "{name}");
     }
     let cells = &mesh.parts[2].material;
     assert_eq!(
@@ -317,6 +317,10 @@ fn isothermal_box_with_dissipation_only() {
     assert!(hi - lo < 0.01 * uniform, "spread {lo}..{hi}");
     assert!(lo < uniform && hi > uniform, "{lo}..{hi} around {uniform}");
     assert!(sol.energy_balance_rel() < 1e-9);
+    // Vertex temperatures (smooth shading) stay within the facet range.
+    let vt = sol.vertex_temperatures_k(&mesh).unwrap();
+    assert_eq!(vt.len(), mesh.vertices.len());
+    assert!(vt.iter().all(|&t| t >= lo && t <= hi));
 }
 
 #[test]

@@ -36,9 +36,19 @@
 //! gradient solve of the symmetric positive-definite Jacobian (conduction Laplacian +
 //! diag(4εσAT³)). The residual is a convex, order-isotone function of T, so from the
 //! first step on the iterates approach the solution from above and converge from any
-//! positive start (Ortega and Rheinboldt, *Iterative Solution of Nonlinear Equations
-//! in Several Variables*, 13.3.4). Conduction is assembled symmetrically, so it
-//! cancels exactly in the energy balance.
+//! positive start (monotone convergence of Newton's method for convex M-functions:
+//! Ortega and Rheinboldt, *Iterative Solution of Nonlinear Equations in Several
+//! Variables*, §13.3). The start is, per facet, the larger of its own radiative
+//! equilibrium and the uniform equilibrium of its conductive group; the iteration stops
+//! when every nodal residual is below [`RESIDUAL_TOLERANCE`] × (absorbed + dissipated
+//! power), typically after 4–5 steps. Conduction is assembled symmetrically, so it
+//! cancels exactly in the energy balance (|absorbed + dissipated − emitted| stays
+//! below 1e-8 of the input).
+//!
+//! Cost (release build, one core): the 6 368-facet cube + cylinder (0.05 m facets)
+//! builds its network in ~5 ms and solves in 11–23 ms; Tango at 0.05 m (2 092
+//! facets) in 1.5 ms + 9–13 ms. Build a [`ThermalNetwork`] once per mesh to solve
+//! many environments.
 
 use std::collections::HashMap;
 use std::fmt;
@@ -271,6 +281,35 @@ impl ThermalSolution {
         it.peek()?;
         Some(min_max(it.map(|t| self.temperature_k[t])))
     }
+
+    /// Temperature at every vertex of `mesh`, K: the area-weighted mean of the facets
+    /// that use it (facets of different parts sharing a vertex included), for smooth
+    /// shading; NaN for a vertex no facet uses. `None` when `mesh` is not the solved
+    /// one (facet counts differ) or a vertex index is out of range.
+    pub fn vertex_temperatures_k(&self, mesh: &Mesh) -> Option<Vec<f64>> {
+        if mesh.facet_count() != self.temperature_k.len() {
+            return None;
+        }
+        let nv = mesh.vertices.len();
+        let mut sum = vec![0.0; nv];
+        let mut weight = vec![0.0; nv];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            if tri.iter().any(|&v| v as usize >= nv) {
+                return None;
+            }
+            let a = mesh.area_m2(t);
+            for &v in tri {
+                sum[v as usize] += a * self.temperature_k[t];
+                weight[v as usize] += a;
+            }
+        }
+        Some(
+            sum.iter()
+                .zip(&weight)
+                .map(|(s, w)| if *w > 0.0 { s / w } else { f64::NAN })
+                .collect(),
+        )
+    }
 }
 
 fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -346,7 +385,7 @@ impl Bvh {
             .map(|t| scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0))
             .collect();
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * tris.len() / 2 + 1),
+            nodes: Vec::with_capacity(tris.len() / 2 + 1),
             order: Vec::new(),
             tris,
         };
@@ -1092,14 +1131,10 @@ impl ThermalNetwork {
             }
             let r = input[i] - rad[i] * (temp[i].powi(4) - ts4) - cond;
             out[i] = r;
-            max_r = if r.is_nan() {
-                f64::NAN
-            } else {
-                max_r.max(r.abs())
-            };
-            if max_r.is_nan() {
+            if r.is_nan() {
                 return f64::NAN;
             }
+            max_r = max_r.max(r.abs());
         }
         max_r
     }
