@@ -9,29 +9,30 @@
 //! chosen in the paper so the target still covers at least 9 pixels; with the Hayabusa2
 //! TIR camera (37 µm pixels, 42.2 mm focal length: IFOV 0.877 mrad) one pixel spans
 //! 0.386 m at 440 m, i.e. 0.149 m². The target's projected area is 1.50 m² side-on
-//! (10.1 px), 1.89 m² on average over all attitudes (its area / 4, 12.7 px) and 1.00 m²
-//! end-on along x (6.7 px, the only attitudes below 9 px): the sizes satisfy the rule
-//! for all but near end-on views at the far bound, the same order as the paper's
-//! statement.
+//! (10.1 px), about 1.9 m² on average over all attitudes (Cauchy: external area / 4 =
+//! 7.57 / 4 m², 12.7 px; slightly less as the body is not convex) and 1.00 m² end-on
+//! along x (6.7 px, the only attitudes below 9 px): the sizes meet the rule for all but
+//! near end-on views at the far bound.
 //!
 //! # Tango sizes (all from public sources or marked as estimates)
 //!
-//! - Bus 0.74 × 0.57 × 0.295 m: the Tango envelope "570 × 740 × 295 mm", 40 kg, of the
-//!   Prisma article of the German Wikipedia (from the SSC/OHB data sheets); the English
-//!   Wikipedia gives "80 cm × 31 cm", consistent with our overall 0.77 m width and
-//!   0.32 m height with the panel.
+//! - Bus 0.74 × 0.57 × 0.295 m: the Tango envelope "570 × 740 × 295 mm" (40 kg) of
+//!   the Prisma article of the German Wikipedia; the English Wikipedia gives
+//!   "80 cm × 31 cm" (50 kg launch mass, 90 W), consistent with our overall 0.77 m
+//!   width and 0.32 m height with the panel. CNES's FFIORD pages give 40 kg.
 //! - One body-mounted solar panel on the +z face (Tango has "fixed solar panels",
-//!   Spaceflight Now, 11 Aug 2010; peak power 90 W), 0.74 × 0.77 m, 25 mm thick,
-//!   overhanging the bus by 0.10 m on ±y: *estimate* from the SPEED renderings of
-//!   Tango (Sharma, Park and D'Amico, the paper's reference \[4\] family), whose
-//!   keypoint model puts the panel corners about ±0.37 × ±0.385 m.
-//! - Three whip antennas (inter-satellite link, VHF/UHF), Ø 10 mm, about 0.29 m long,
-//!   in the plane 0.045 m below the panel: two from the +y wall at 45° outwards, one
-//!   normal to the −y wall. Tip positions are an *estimate* after the SPEED keypoints
-//!   (tips near (±0.54, 0.49) and (0.31, −0.58) m); diameter an *estimate*.
-//! - Two patch antennas (GPS / S-band / formation-flying RF), 0.10 × 0.10 × 0.02 m,
-//!   on the −z face: sizes and positions are *estimates* (Tango carried GPS and FFRF
-//!   antennas, CNES FFIORD pages).
+//!   Spaceflight Now, 11 Aug 2010), 0.74 × 0.77 m, 25 mm thick, overhanging the bus
+//!   by 0.10 m on ±y: *estimate*, after the Tango model of the SPEED dataset
+//!   (Sharma and D'Amico's group, who also wrote the paper's reference \[4\]) as we
+//!   recall its keypoints (panel corners near ±0.37 × ±0.385 m), not re-checked
+//!   against the dataset files.
+//! - Three whip antennas (inter-satellite link), Ø 10 mm, about 0.29 m long, in the
+//!   plane 0.045 m below the panel: two from the +y wall at 45° outwards, one normal
+//!   to the −y wall. Tips near (±0.54, 0.49) and (0.31, −0.58) m after the same
+//!   recalled SPEED keypoints: *estimate*; diameter: *estimate*.
+//! - Two patch antennas (GPS / formation-flying RF), 0.10 × 0.10 × 0.02 m, on the −z
+//!   face: sizes and positions are *estimates* (Tango carried GPS and FFRF antennas,
+//!   CNES FFIORD pages).
 //!
 //! # Tango materials (optical values after Gilmore, *Spacecraft Thermal Control
 //! Handbook*, Vol. I, App. A, typical beginning-of-life values; assignment to
@@ -49,6 +50,10 @@ use crate::geom::{Vec3, norm, sub};
 /// 13–44 mm): 0.05 m, fine enough to carry the conduction gradients and to keep the
 /// cylinder's polygon within 1.2 mm of the circle.
 pub const DEFAULT_RESOLUTION_M: f64 = 0.05;
+
+/// Recommended facet edge length at far range (340–440 m, pixels of 0.30–0.39 m):
+/// 0.2 m, about half a pixel (508 facets for the cube + cylinder, 300 for Tango).
+pub const FAR_RESOLUTION_M: f64 = 0.2;
 
 /// Thermal conductivity of aluminium alloy 6061-T6, W m⁻¹ K⁻¹ (ASM handbook value).
 pub const ALUMINIUM_CONDUCTIVITY_W_M_K: f64 = 167.0;
