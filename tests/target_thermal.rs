@@ -702,3 +702,89 @@ fn report() {
         &ThermalEnvironment::sunlit([0.3, 0.2, 0.93], [0.0, 0.0, -1.0]),
     );
 }
+
+/// Random triangle soups (overlapping, open, intersecting, some degenerate) never
+/// panic; when they solve, the energy balances.
+#[test]
+fn random_soups_solve_or_refuse() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut rnd = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut solved, mut refused) = (0, 0);
+    for case in 0..200 {
+        let nt = 1 + (rnd() * 40.0) as usize;
+        let nv = 3 + (rnd() * 30.0) as usize;
+        let vertices: Vec<[f64; 3]> = (0..nv)
+            .map(|_| [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5])
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..nt)
+            .map(|_| [0, 1, 2].map(|_| (rnd() * nv as f64) as u32 % nv as u32))
+            .collect();
+        let parts = vec![
+            Part {
+                name: "a",
+                material: Material {
+                    name: "a",
+                    solar_absorptivity: rnd(),
+                    ir_emissivity: 0.01 + 0.99 * rnd(),
+                    conductivity_w_m_k: 200.0 * rnd(),
+                    thickness_m: 0.01 * rnd(),
+                },
+                dissipation_w: if case % 3 == 0 { 10.0 * rnd() } else { 0.0 },
+            },
+            Part {
+                name: "b",
+                material: Material {
+                    name: "b",
+                    solar_absorptivity: rnd(),
+                    ir_emissivity: 0.01 + 0.99 * rnd(),
+                    conductivity_w_m_k: 0.0,
+                    thickness_m: 0.0,
+                },
+                dissipation_w: 0.0,
+            },
+        ];
+        let part_of = (0..nt).map(|_| (rnd() * 2.0) as u16 % 2).collect();
+        let mesh = Mesh {
+            vertices,
+            triangles,
+            part_of,
+            parts,
+        };
+        let sun = [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5];
+        let env = if case % 2 == 0 {
+            ThermalEnvironment::sunlit(sun, [0.0, 0.0, -1.0])
+        } else {
+            ThermalEnvironment::eclipse(sun)
+        };
+        match solve_steady_state(&mesh, &env) {
+            Ok(sol) => {
+                solved += 1;
+                assert!(
+                    sol.energy_balance_rel() < 1e-6,
+                    "case {case}: {}",
+                    sol.energy_balance_rel()
+                );
+                assert!(sol.temperature_k.iter().all(|t| t.is_finite() && *t >= 3.0));
+            }
+            Err(e) => {
+                refused += 1;
+                assert!(
+                    matches!(
+                        e,
+                        ThermalError::DegenerateFacet { .. } | ThermalError::NoSteadyState { .. }
+                    ),
+                    "case {case}: {e}"
+                );
+            }
+        }
+    }
+    assert!(
+        solved > 20 && refused > 20,
+        "{solved} solved, {refused} refused"
+    );
+}
