@@ -440,6 +440,11 @@ mod tests {
             assert_eq!(c.label().parse::<MaterialCase>(), Ok(c));
         }
         assert!("multi3".parse::<MaterialCase>().is_err());
+        for c in MaterialCase::ALL {
+            let json = serde_json::to_string(&c).unwrap();
+            assert_eq!(json, format!("\"{}\"", c.label()));
+            assert_eq!(serde_json::from_str::<MaterialCase>(&json).unwrap(), c);
+        }
     }
 
     #[test]
