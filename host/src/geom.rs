@@ -106,6 +106,29 @@ impl Rotation {
             ))
     }
 
+    /// The shortest rotation taking direction `from` onto direction `to` (any non-zero
+    /// vectors); opposite directions turn by π about an axis perpendicular to `from`.
+    pub fn between(from: Vec3, to: Vec3) -> Rotation {
+        let a = normalize(from);
+        let b = normalize(to);
+        let axis = cross(a, b);
+        let s = norm(axis);
+        let c = dot(a, b);
+        if s > 1e-12 {
+            return Rotation::about_axis(axis, s.atan2(c));
+        }
+        if c > 0.0 {
+            return Rotation::IDENTITY;
+        }
+        // Antiparallel: any axis perpendicular to `a`.
+        let helper = if a[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        Rotation::about_axis(cross(a, helper), std::f64::consts::PI)
+    }
+
     /// M·v.
     pub fn apply(&self, v: Vec3) -> Vec3 {
         let m = &self.0;
@@ -166,6 +189,19 @@ mod tests {
             r.inverse().apply(r.apply([1.0, 2.0, 3.0])),
             [1.0, 2.0, 3.0]
         ));
+    }
+
+    #[test]
+    fn between_maps_from_onto_to() {
+        for (a, b) in [
+            ([1.0, 2.0, 3.0], [-0.5, 0.1, 2.0]),
+            ([0.0, 0.0, 1.0], [0.0, 0.0, 5.0]),
+            ([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),
+            ([1.0, 0.0, 0.0], [-3.0, 0.0, 0.0]),
+        ] {
+            let r = Rotation::between(a, b);
+            assert!(close(r.apply(normalize(a)), normalize(b)), "{a:?} -> {b:?}");
+        }
     }
 
     #[test]

@@ -6,12 +6,15 @@
 #![deny(missing_docs)]
 
 pub mod cli;
+pub mod dataset;
 pub mod earth;
 pub mod figure;
 pub mod fixture;
 pub mod geom;
 pub mod image_io;
+pub mod render;
 pub mod run;
+pub mod scene;
 /// `tirroi sensor`: the thermal camera model of `tirroi_core::sensor` as tables or JSON.
 pub mod sensor_view;
 pub mod target;

@@ -1,0 +1,263 @@
+//! `tirroi render`: labelled datasets that are the same bytes for a seed (whatever the
+//! thread count), resumable, with errors that name the file, line and field.
+
+mod cli_common;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
+use std::process::Command;
+
+use cli_common::{run, tirroi};
+
+/// Every scene kind in a few images, on a coarse Earth mesh to keep debug builds quick.
+const SMALL: &str = r#"
+[dataset]
+name = "small"
+seed = 3
+thermal_states = 2
+
+[earth_model]
+mesh_deg = 0.5
+days = 1
+
+[[scene]]
+name = "det"
+count = 3
+mode = "detection"
+scale = [1, 2, 3]
+range_m = { min = 15.0, max = 50.0 }
+earth_off_boresight_deg = 30.0
+
+[[scene]]
+name = "rad-far"
+count = 2
+mode = "radiometry"
+material = ["multi-1", "multi-2"]
+illumination = ["sunlit", "eclipse"]
+range_m = { min = 340.0, max = 440.0 }
+resolution_m = 0.1
+
+[[scene]]
+name = "tango-fixed"
+count = 1
+target = "tango"
+range_m = 20.0
+attitude_deg = [10.0, 20.0, 30.0]
+offset_px = [10.0, -5.0]
+noise = false
+earth = false
+"#;
+
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    for sub in ["", "masks", "preview"] {
+        let d = dir.join(sub);
+        let Ok(entries) = fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.path().is_file() {
+                let name = format!("{sub}/{}", e.file_name().to_string_lossy());
+                out.insert(name, fs::read(e.path()).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn render_into(config: &Path, out: &Path, threads: &str, extra: &[&str]) -> String {
+    let o = Command::new(tirroi())
+        .env("RAYON_NUM_THREADS", threads)
+        .args(["render", "--config"])
+        .arg(config)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+#[test]
+fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = tmp.path().join("small.toml");
+    fs::write(&config, SMALL).unwrap();
+    let a = tmp.path().join("a");
+    let b = tmp.path().join("b");
+    let report = render_into(&config, &a, "1", &["--masks", "--preview"]);
+    assert!(report.contains("6 images rendered"), "{report}");
+    assert!(report.contains("per-image CPU time by stage"), "{report}");
+    render_into(&config, &b, "2", &["--masks", "--preview"]);
+    let fa = files(&a);
+    let fb = files(&b);
+    assert_eq!(fa.keys().collect::<Vec<_>>(), fb.keys().collect::<Vec<_>>());
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{name} differs between 1 and 2 threads");
+    }
+    // 6 PNG + 6 masks + 6 previews + truth.csv + coco.json + metadata.jsonl, nothing else.
+    assert_eq!(fa.len(), 21, "{:?}", fa.keys().collect::<Vec<_>>());
+    assert!(
+        !fa.keys()
+            .any(|k| k.ends_with(".part") || k.contains("progress"))
+    );
+
+    let truth = String::from_utf8(fa["/truth.csv"].clone()).unwrap();
+    let mut lines = truth.lines();
+    assert!(lines.next().unwrap().starts_with("file,x0,y0,x1,y1,"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6);
+    for r in &rows {
+        let b: Vec<u16> = r[1..5].iter().map(|v| v.parse().unwrap()).collect();
+        assert!(
+            b[0] < b[2] && b[1] < b[3] && b[2] <= 328 && b[3] <= 248,
+            "{r:?}"
+        );
+    }
+    // Detection: one pose at the three scales shares its box; modes and scales labelled.
+    assert_eq!(rows[0][1..5], rows[1][1..5]);
+    assert_eq!(rows[0][1..5], rows[2][1..5]);
+    assert_eq!((rows[0][5], rows[0][6]), ("detection", "1"));
+    assert_eq!((rows[2][5], rows[2][6]), ("detection", "3"));
+    assert_eq!(
+        (rows[3][5], rows[3][8], rows[3][9]),
+        ("radiometry", "multi-1", "sunlit")
+    );
+    // Poses enumerate material × illumination: the second pose is multi-2, sunlit.
+    assert_eq!((rows[4][8], rows[4][9]), ("multi-2", "sunlit"));
+    assert_eq!(rows[5][7], "tango");
+
+    // The PNG is the DN the metadata describes: 16-bit, 328 × 248, inside 14 bits.
+    let img = image::load_from_memory(&fa["/000000.png"])
+        .unwrap()
+        .into_luma16();
+    assert_eq!(img.dimensions(), (328, 248));
+    assert!(img.pixels().all(|p| p.0[0] <= 16383));
+    // Detection mode: the target saturates (Section 4.1).
+    assert!(img.pixels().any(|p| p.0[0] == 16383));
+    // The mask's ≥ 50 % pixels span exactly the truth box.
+    let mask = image::load_from_memory(&fa["masks/000000.png"])
+        .unwrap()
+        .into_luma8();
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (x, y, p) in mask.enumerate_pixels() {
+        if p.0[0] >= 128 {
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+        }
+    }
+    let b: Vec<u32> = rows[0][1..5].iter().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(vec![x0, y0, x1, y1], b);
+
+    let coco: serde_json::Value = serde_json::from_slice(&fa["/coco.json"]).unwrap();
+    assert_eq!(coco["images"].as_array().unwrap().len(), 6);
+    assert_eq!(coco["annotations"].as_array().unwrap().len(), 6);
+    let ann = &coco["annotations"][0];
+    assert_eq!(ann["bbox"][0].as_u64().unwrap() as u32, b[0]);
+    assert_eq!(ann["bbox"][2].as_u64().unwrap() as u32, b[2] - b[0]);
+    let meta: Vec<serde_json::Value> = String::from_utf8(fa["/metadata.jsonl"].clone())
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(meta.len(), 6);
+    assert!(meta[0]["earth_fraction"].as_f64().unwrap() > 0.0);
+    assert_eq!(meta[5]["earth_fraction"].as_f64().unwrap(), 0.0);
+    assert_eq!(meta[5]["noise_sigma_dn"].as_f64().unwrap(), 0.0);
+    assert!(meta[0]["noise_sigma_dn"].as_f64().unwrap() > 0.0);
+    let t = &meta[3]["target_temperature_k"];
+    assert!(t[0].as_f64().unwrap() < t[1].as_f64().unwrap());
+}
+
+#[test]
+fn a_stopped_run_resumes_to_the_same_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = tmp.path().join("small.toml");
+    fs::write(&config, SMALL).unwrap();
+    let full = tmp.path().join("full");
+    render_into(&config, &full, "2", &[]);
+    // Simulate a stop after 4 images: the journal lists them, no label files yet.
+    let part = tmp.path().join("part");
+    fs::create_dir(&part).unwrap();
+    let meta = fs::read_to_string(full.join("metadata.jsonl")).unwrap();
+    let journal: String = meta.lines().take(4).map(|l| format!("{l}\n")).collect();
+    fs::write(part.join("progress.jsonl"), journal).unwrap();
+    for i in 0..4 {
+        let name = format!("{i:06}.png");
+        fs::copy(full.join(&name), part.join(&name)).unwrap();
+    }
+    let report = render_into(&config, &part, "2", &["--resume"]);
+    assert!(report.contains("2 images rendered (4 resumed)"), "{report}");
+    let (a, b) = (files(&full), files(&part));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (name, bytes) in &a {
+        assert!(bytes == &b[name], "{name} differs after resuming");
+    }
+}
+
+#[test]
+fn bad_scene_files_name_the_file_line_and_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.toml");
+    fs::write(&bad, "[[scene]]\nrange_m = 20.0\nmaterial = \"gold\"\n").unwrap();
+    let o = run(&[
+        "render",
+        "--config",
+        bad.to_str().unwrap(),
+        "--out",
+        "/nonexistent/x",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.toml:3:"), "{err}");
+    assert!(err.starts_with("tirroi: error:"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+
+    fs::write(&bad, "[[scene]]\nrange_m = { min = 0.0, max = 10.0 }\n").unwrap();
+    let o = run(&["render", "--config", bad.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(err.contains("scene[0].range_m"), "{err}");
+
+    let o = run(&["render", "--config", "/no/such/file.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read"));
+
+    let o = run(&["render", "--preset", "nope"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("paper, tango, quick"));
+}
+
+#[test]
+fn presets_list_and_print_as_toml_that_parses_back() {
+    let o = run(&["render", "--list-presets"]);
+    assert!(o.status.success());
+    let list = String::from_utf8_lossy(&o.stdout);
+    for p in ["paper", "tango", "quick"] {
+        assert!(list.contains(p), "{list}");
+    }
+    let o = run(&[
+        "render",
+        "--preset",
+        "paper",
+        "--count",
+        "120",
+        "--print-config",
+    ]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("paper120.toml");
+    fs::write(&path, &text).unwrap();
+    let o = run(&[
+        "render",
+        "--config",
+        path.to_str().unwrap(),
+        "--print-config",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(String::from_utf8_lossy(&o.stdout), text);
+    assert_eq!(text.matches("count = 30").count(), 4, "{text}");
+}
