@@ -200,7 +200,7 @@ impl Illumination {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(
     untagged,
-    expecting = "a number, or a table { min = <number>, max = <number> }"
+    expecting = "expected a number, or a table { min = <number>, max = <number> }"
 )]
 pub enum Param {
     /// The same value for every image.
@@ -253,7 +253,7 @@ impl fmt::Display for Param {
 
 /// One value, or a list that consecutive poses cycle through.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged, expecting = "one value or a list of values")]
+#[serde(untagged, expecting = "not an accepted value")]
 pub enum OneOrMany<T> {
     /// One value.
     One(T),
@@ -664,10 +664,13 @@ impl SceneFile {
     /// [`SceneError`] with the line and field for syntax errors, unknown keys, wrong
     /// types and out-of-range values.
     pub fn parse(text: &str, source: &str) -> Result<SceneFile, SceneError> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| SceneError {
-            source: source.to_string(),
-            line_col: e.span().map(|s| line_col(text, s.start)),
-            message: e.message().trim().replace('\n', " "),
+        let file: SceneFile = toml::from_str(text).map_err(|e| {
+            let at = e.span().map(|s| s.start);
+            SceneError {
+                source: source.to_string(),
+                line_col: at.map(|a| line_col(text, a)),
+                message: explain(e.message().trim(), at.and_then(|a| key_at(text, a))),
+            }
         })?;
         file.validate().map_err(|message| SceneError {
             source: source.to_string(),
@@ -775,6 +778,39 @@ impl SceneFile {
     }
 }
 
+/// The key of the `key = value` line holding byte `offset`, if any.
+fn key_at(text: &str, offset: usize) -> Option<&str> {
+    let start = text[..offset.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?;
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim();
+    (!key.is_empty() && !key.starts_with('[')).then_some(key)
+}
+
+/// The parser's message, with the field named and the accepted values spelled out.
+fn explain(message: &str, key: Option<&str>) -> String {
+    let message = message.replace('\n', " ");
+    let Some(key) = key else {
+        return message;
+    };
+    let accepted = match key {
+        "mode" => Some("\"radiometry\" or \"detection\""),
+        "target" => Some("\"cube-cylinder\" or \"tango\""),
+        "material" => Some("\"mono\", \"multi-1\", \"multi-2\", or a list of them"),
+        "illumination" => Some("\"sunlit\", \"eclipse\", or a list of them"),
+        "scale" => Some("1, 2, 3, or a list of them"),
+        "source" => Some("\"builtin\" or \"netcdf\""),
+        _ => None,
+    };
+    match accepted {
+        Some(a) if !message.contains(a) => format!("`{key}`: {message}; expected {a}"),
+        _ if message.contains(&format!("`{key}`")) => message,
+        _ => format!("`{key}`: {message}"),
+    }
+}
+
 /// 1-based line and column of byte `offset` in `text`.
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
@@ -824,12 +860,15 @@ mod tests {
         let e = SceneFile::parse("[[scene]]\nrange_m = \"far\"\n", "x.toml").unwrap_err();
         assert!(e.to_string().contains("x.toml:2:"), "{e}");
         assert!(e.to_string().contains("a number, or a table"), "{e}");
+        assert!(e.to_string().contains("`range_m`"), "{e}");
         let e =
             SceneFile::parse("[[scene]]\nrange_m = { min = 50.0, max = 15.0 }\n", "x").unwrap_err();
         assert!(e.to_string().contains("scene[0].range_m"), "{e}");
         let e =
             SceneFile::parse("[[scene]]\nrange_m = 20.0\nmaterial = \"gold\"\n", "x").unwrap_err();
         assert!(e.to_string().contains("x:3:"), "{e}");
+        assert!(e.to_string().contains("`material`"), "{e}");
+        assert!(e.to_string().contains("\"multi-1\""), "{e}");
         let e = SceneFile::parse(
             "[[scene]]\nrange_m = 20.0\nmode = \"detection\"\nscale = [1, 2]\ncount = 3\n",
             "x",
