@@ -261,3 +261,53 @@ fn presets_list_and_print_as_toml_that_parses_back() {
     assert_eq!(String::from_utf8_lossy(&o.stdout), text);
     assert_eq!(text.matches("count = 30").count(), 4, "{text}");
 }
+
+#[test]
+fn eval_scores_a_directory_of_frames_per_method_and_group() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fixtures = tmp.path().join("fx");
+    let o = run(&["fixtures", "--out", fixtures.to_str().unwrap()]);
+    assert!(o.status.success());
+    let out = tmp.path().join("eval");
+    let o = run(&[
+        "eval",
+        "--images",
+        fixtures.to_str().unwrap(),
+        "--method",
+        "otsu",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table.starts_with("| method | group | frames | mean IoU"),
+        "{table}"
+    );
+    // Otsu finds the target over deep space exactly (a bimodal histogram).
+    let scores = fs::read_to_string(out.join("scores.csv")).unwrap();
+    let deep = scores
+        .lines()
+        .find(|l| l.starts_with("deep-space.png,otsu"))
+        .unwrap();
+    let cols: Vec<&str> = deep.split(',').collect();
+    assert_eq!(cols[10], "1.0000", "{deep}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary[0]["method"], "otsu");
+    assert_eq!(summary[0]["frames"], 4);
+
+    // A bad truth file names the file and the line.
+    let bad = tmp.path().join("bad.csv");
+    fs::write(&bad, "file,x0,y0,x1,y1\nearth.png,1,2,x,4\n").unwrap();
+    let o = run(&[
+        "eval",
+        "--images",
+        fixtures.to_str().unwrap(),
+        "--truth",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.csv:2: x1 = `x`"), "{err}");
+}

@@ -12,7 +12,7 @@ use crate::image_io::read_frame;
 use crate::run::DetectorBank;
 use crate::scene::{self, SceneFile};
 use crate::sensor_view::{self, SensorRequest};
-use crate::{dataset, figure, fixture};
+use crate::{dataset, eval, figure, fixture};
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
@@ -91,6 +91,33 @@ pub enum Command {
     ///                     "sigma_t4_over_pi_w_m2_sr","dn","saturated","t_rad_k"}]}
     #[command(verbatim_doc_comment)]
     Sensor(SensorArgs),
+    /// Score detectors on a directory of 16-bit PNG frames with a truth.csv: mean and
+    /// median IoU, hit rate (IoU >= 0.5) and core time per method and per group
+    /// (mode, scale, target, material, illumination, range band). Markdown on stdout;
+    /// scores.csv, summary.csv and summary.json in --out.
+    Eval {
+        /// Directory of frames.
+        #[arg(long)]
+        images: PathBuf,
+        /// Labels (default: IMAGES/truth.csv), header `file,x0,y0,x1,y1[,extra...]`.
+        #[arg(long)]
+        truth: Option<PathBuf>,
+        /// Detector: otsu, adaptive, wge, dog, or all.
+        #[arg(long, default_value = "all", value_parser = parse_methods)]
+        method: MethodChoice,
+        /// Runs per frame and method; the reported time is the median.
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        repeat: u32,
+        /// Mask-to-box rule: largest-component or all-foreground.
+        #[arg(long, default_value = "largest-component", value_parser = parse_box_rule)]
+        box_rule: BoxRule,
+        /// Bit depth of the DN (default: 14 for 16-bit files whose DN fit).
+        #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
+        bits: Option<u8>,
+        /// Write scores.csv, summary.csv and summary.json here.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Render a labelled synthetic dataset: 16-bit PNG of DN, truth.csv, coco.json and
     /// metadata.jsonl (optionally masks/ and preview/), from a preset or a TOML file.
     ///
@@ -214,6 +241,16 @@ pub struct SensorArgs {
     pub json: bool,
 }
 
+fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
+    match s {
+        "largest-component" => Ok(BoxRule::LargestComponent),
+        "all-foreground" => Ok(BoxRule::AllForeground),
+        _ => Err(format!(
+            "unknown box rule `{s}`; expected largest-component or all-foreground"
+        )),
+    }
+}
+
 /// One method or all of them.
 #[derive(Debug, Clone)]
 pub struct MethodChoice(pub Vec<Method>);
@@ -267,6 +304,29 @@ pub fn main() -> ExitCode {
             }
         },
         Command::Sensor(args) => sensor(&args),
+        Command::Eval {
+            images,
+            truth,
+            method,
+            repeat,
+            box_rule,
+            bits,
+            out,
+        } => {
+            let options = eval::EvalOptions {
+                methods: method.0,
+                repeat: repeat as usize,
+                box_rule,
+                bits,
+            };
+            match run_eval(&images, truth.as_deref(), &options, out.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("tirroi: error: {e}");
+                    ExitCode::from(EXIT_BAD_INPUT)
+                }
+            }
+        }
         Command::Render(args) => match render_dataset(&args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
@@ -275,6 +335,48 @@ pub fn main() -> ExitCode {
             }
         },
     }
+}
+
+/// A progress bar on stderr when it is a terminal (hidden otherwise).
+pub fn progress_bar(len: usize, what: &str) -> indicatif::ProgressBar {
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len as u64);
+    let template = format!(
+        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {what} ({{per_sec}}, eta {{eta}})"
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+fn run_eval(
+    images: &std::path::Path,
+    truth: Option<&std::path::Path>,
+    options: &eval::EvalOptions,
+    out: Option<&std::path::Path>,
+) -> Result<(), String> {
+    let truth = truth.map_or_else(|| images.join("truth.csv"), std::path::Path::to_path_buf);
+    let rows = eval::read_truth(&truth).map_err(|e| e.to_string())?;
+    let bar = progress_bar(rows.len(), "frames");
+    let scores = eval::score(images, &rows, options, &DetectorBank::default, &|| {
+        bar.inc(1)
+    })
+    .map_err(|e| e.to_string())?;
+    bar.finish_and_clear();
+    let stats = eval::summarise(&scores);
+    print!("{}", eval::markdown(&stats));
+    if let Some(out) = out {
+        eval::write_reports(out, &scores, &stats).map_err(|e| e.to_string())?;
+        println!(
+            "\nwrote scores.csv, summary.csv and summary.json to {}",
+            out.display()
+        );
+    }
+    Ok(())
 }
 
 fn render_dataset(args: &RenderArgs) -> Result<(), String> {

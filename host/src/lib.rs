@@ -8,6 +8,7 @@
 pub mod cli;
 pub mod dataset;
 pub mod earth;
+pub mod eval;
 pub mod figure;
 pub mod fixture;
 pub mod geom;
