@@ -28,6 +28,8 @@ pub struct TruthRow {
     pub roi: Roi,
     /// Group labels from the extra columns: (column, value).
     pub groups: Vec<(String, String)>,
+    /// Camera–target distance, m, when the file has a `range_m` column.
+    pub range_m: Option<f64>,
 }
 
 /// Columns that become groups; `range_m` becomes `range` (close / mid / far).
@@ -109,6 +111,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             )));
         }
         let mut groups = Vec::new();
+        let mut range_m = None;
         for (name, value) in header.iter().zip(&cols).skip(5) {
             if value.is_empty() {
                 continue;
@@ -118,6 +121,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             } else if *name == "range_m" {
                 if let Ok(r) = value.parse::<f64>() {
                     groups.push(("range".into(), range_band(r).into()));
+                    range_m = Some(r);
                 }
             }
         }
@@ -125,6 +129,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             file: cols[0].to_string(),
             roi: Roi::new(b[0], b[1], b[2], b[3]),
             groups,
+            range_m,
         });
     }
     Ok(rows)
@@ -147,6 +152,8 @@ pub struct FrameScore {
     pub time_us: f64,
     /// Group labels.
     pub groups: Vec<(String, String)>,
+    /// Camera–target distance, m, when known.
+    pub range_m: Option<f64>,
 }
 
 /// How to run an evaluation.
@@ -202,6 +209,7 @@ pub fn score(
                         iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
                         time_us,
                         groups: row.groups.clone(),
+                        range_m: row.range_m,
                     });
                 }
                 progress();
