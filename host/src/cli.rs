@@ -12,7 +12,7 @@ use crate::image_io::read_frame;
 use crate::run::DetectorBank;
 use crate::scene::{self, SceneFile};
 use crate::sensor_view::{self, SensorRequest};
-use crate::{dataset, eval, figure, fixture};
+use crate::{dataset, eval, figure, fixture, paper};
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
@@ -117,6 +117,20 @@ pub enum Command {
         /// Write scores.csv, summary.csv and summary.json here.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Reproduce the paper's results: render (or reuse) the datasets, score every
+    /// detector, print Tables 6, 7 and 8 beside the paper's, and write the figures.
+    /// The default command (`cargo run --release`): a reduced run of 1 200 + 300 images.
+    Paper {
+        /// Where datasets, reports and figures go.
+        #[arg(long, default_value = "paper-run")]
+        out: PathBuf,
+        /// Full-size datasets: 12 000 + 1 000 images.
+        #[arg(long)]
+        full: bool,
+        /// Runs per frame and method for the timing (median).
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+        repeat: u32,
     },
     /// Render a labelled synthetic dataset: 16-bit PNG of DN, truth.csv, coco.json and
     /// metadata.jsonl (optionally masks/ and preview/), from a preset or a TOML file.
@@ -327,6 +341,21 @@ pub fn main() -> ExitCode {
                 }
             }
         }
+        Command::Paper { out, full, repeat } => {
+            let options = paper::PaperOptions {
+                out,
+                full,
+                repeat: repeat as usize,
+                progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            };
+            match run_paper(&options) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("tirroi: error: {e}");
+                    ExitCode::from(EXIT_BAD_INPUT)
+                }
+            }
+        }
         Command::Render(args) => match render_dataset(&args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
@@ -376,6 +405,21 @@ fn run_eval(
             out.display()
         );
     }
+    Ok(())
+}
+
+fn run_paper(options: &paper::PaperOptions) -> Result<(), String> {
+    let start = std::time::Instant::now();
+    let scores = paper::run(options)?;
+    let report = paper::report(&scores);
+    println!("{report}");
+    let path = options.out.join("tables.md");
+    std::fs::write(&path, &report).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    println!(
+        "tables: {} ({:.0} s in all)",
+        path.display(),
+        start.elapsed().as_secs_f64()
+    );
     Ok(())
 }
 

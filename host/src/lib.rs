@@ -13,6 +13,7 @@ pub mod figure;
 pub mod fixture;
 pub mod geom;
 pub mod image_io;
+pub mod paper;
 pub mod render;
 pub mod run;
 pub mod scene;
