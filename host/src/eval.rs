@@ -392,6 +392,7 @@ mod tests {
                 .iter()
                 .map(|(k, v)| (k.to_string(), v.to_string()))
                 .collect(),
+            range_m: None,
         }
     }
 
