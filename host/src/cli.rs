@@ -125,6 +125,9 @@ pub enum Command {
         /// Where datasets, reports and figures go.
         #[arg(long, default_value = "paper-run")]
         out: PathBuf,
+        /// Where the figures go (PNG).
+        #[arg(long, default_value = "docs/paper")]
+        figures: PathBuf,
         /// Full-size datasets: 12 000 + 1 000 images.
         #[arg(long)]
         full: bool,
@@ -290,9 +293,11 @@ struct DetectLine<'a> {
 /// Runs the command line; returns the process exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command.unwrap_or(Command::Demo {
-        repeat: 21,
-        figures: Some(PathBuf::from("docs")),
+    match cli.command.unwrap_or(Command::Paper {
+        out: PathBuf::from("paper-run"),
+        figures: PathBuf::from("docs/paper"),
+        full: false,
+        repeat: 3,
     }) {
         Command::Detect {
             method,
@@ -341,9 +346,15 @@ pub fn main() -> ExitCode {
                 }
             }
         }
-        Command::Paper { out, full, repeat } => {
+        Command::Paper {
+            out,
+            figures,
+            full,
+            repeat,
+        } => {
             let options = paper::PaperOptions {
                 out,
+                figures,
                 full,
                 repeat: repeat as usize,
                 progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),

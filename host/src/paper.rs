@@ -62,6 +62,8 @@ pub const TABLE8: [PaperRow; 2] = [
 pub struct PaperOptions {
     /// Where datasets, reports and figures go.
     pub out: PathBuf,
+    /// Where the figures go.
+    pub figures: PathBuf,
     /// Full-size datasets (12 000 + 1 000 images) instead of the reduced run.
     pub full: bool,
     /// Runs per frame and method for the timing (median).
