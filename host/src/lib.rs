@@ -14,6 +14,7 @@ pub mod fixture;
 pub mod geom;
 pub mod image_io;
 pub mod paper;
+pub mod plots;
 pub mod render;
 pub mod run;
 pub mod scene;
