@@ -21,3 +21,5 @@ pub mod scene;
 /// `tirroi sensor`: the thermal camera model of `tirroi_core::sensor` as tables or JSON.
 pub mod sensor_view;
 pub mod target;
+pub mod tune;
+pub mod tuned;
