@@ -372,3 +372,28 @@ fn target_pixels_skip_the_earth() {
     assert_eq!(out.stats.earth_rays, 328 * 248 - full);
     assert!(out.earth_fraction < 1.0 - full as f64 / (328.0 * 248.0) + 0.01);
 }
+
+#[test]
+fn a_uniform_radiometry_scene_keeps_a_usable_range_and_noise() {
+    // One temperature: Eq. 17 alone has no range; the renderer keeps 10 NETDs of span so
+    // the noise (NETD-scaled) stays finite and the plate sits mid-scale.
+    let camera = Camera::default();
+    let b = band();
+    let mesh = plate(1.0, 0.9);
+    let temps = vec![300.0, 300.0];
+    let target = TargetView {
+        mesh: &mesh,
+        temperature_k: &temps,
+        body_to_camera: Rotation::IDENTITY,
+        centre_m: [0.0, 0.0, 400.0],
+    };
+    let mut i = input(&camera, Readout::Radiometry, Some(target), None, &b);
+    i.noise_seed = Some(5);
+    let out = render(&i).unwrap();
+    let expected_sigma = 16383.0 / tirroi::host::render::MIN_RANGE_NETD as f32;
+    assert!(
+        (out.noise_sigma_dn - expected_sigma).abs() < 0.02 * expected_sigma,
+        "{}",
+        out.noise_sigma_dn
+    );
+}

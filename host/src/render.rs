@@ -48,6 +48,9 @@ use crate::target::Mesh;
 pub const SUPERSAMPLES_PER_AXIS: usize = 4;
 const SAMPLES: usize = SUPERSAMPLES_PER_AXIS * SUPERSAMPLES_PER_AXIS;
 const NO_FACET: u32 = u32::MAX;
+/// Narrowest radiometry range (Eq. 17), in NETDs of F at the reference temperature
+/// (10 × 0.4 K: 4 K at 300 K): a scene of (nearly) one temperature keeps a usable DN map.
+pub const MIN_RANGE_NETD: f64 = 10.0;
 /// Coverage at or above which a pixel belongs to the target's mask and truth box.
 pub const MASK_COVERAGE: f32 = 0.5;
 
@@ -267,9 +270,22 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     let mapping = match input.readout {
         Readout::Detection(scale) => DnMapping::detection(scale, bits)?,
         Readout::Radiometry => {
+            // Eq. 17 over the pure pixels, with the span kept at least
+            // MIN_RANGE_NETD NETDs wide (in F at the reference temperature), so a
+            // near-uniform scene is not stretched until its noise fills the frame.
             let (lo, hi) = pure.bounds().unwrap_or((0.0, 0.0));
-            let lo = if hi > lo { lo } else { 0.0 };
-            let hi = if hi > lo { hi } else { 1.0 };
+            let min_span = MIN_RANGE_NETD
+                * input.camera.netd_k
+                * std::f64::consts::PI
+                * input
+                    .band
+                    .radiance_derivative_w_m2_sr_k(input.camera.netd_reference_k, 1.0)?;
+            let (lo, hi) = if hi - lo >= min_span && hi > lo {
+                (lo, hi)
+            } else {
+                let lo = (0.5 * (lo + hi) - 0.5 * min_span).max(0.0);
+                (lo, lo + min_span.max(f64::MIN_POSITIVE))
+            };
             DnMapping::radiometry_auto(lo, hi, bits)?
         }
     };
