@@ -19,7 +19,7 @@ thermal_states = 2
 
 [earth_model]
 mesh_deg = 0.5
-days = 1
+days = 2
 
 [[scene]]
 name = "det"

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
@@ -34,14 +34,14 @@ use tirroi_core::Roi;
 use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
 
 use crate::earth::{EarthMap, OlrGrid};
-use crate::figure;
 use crate::geom::{Rotation, Vec3, normalize, scale};
-use crate::image_io::FrameBuf;
+use crate::image_io::{self, FrameBuf};
 use crate::render::{self, EarthView, Readout, RenderInput, RenderStats, Rendered, TargetView};
 use crate::scene::{EarthSource, Illumination, Mode, SceneFile, TargetModel};
 use crate::target::{
     MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
 };
+use crate::{figure, progress};
 
 /// Everything that fixes one image.
 #[derive(Debug, Clone, PartialEq)]
@@ -355,7 +355,9 @@ impl Library {
         let mut days: Vec<usize> = plans.iter().map(|p| p.earth_day).collect();
         days.sort_unstable();
         days.dedup();
-        let grids: HashMap<usize, OlrGrid> = days
+        // Ordered by day: the thermal network below takes the first day's mean flux, and
+        // a HashMap's per-process order would make that choice (and the bytes) vary.
+        let grids: BTreeMap<usize, OlrGrid> = days
             .iter()
             .map(|&d| Ok((d, olr_grid(file, d)?)))
             .collect::<Result<_, DatasetError>>()?;
@@ -376,7 +378,7 @@ impl Library {
             .collect::<Result<_, _>>()?;
         let t2 = Instant::now();
 
-        // Thermal solutions: the Earth's mean flux of day 0 heats the target.
+        // Thermal solutions: the mean flux of the first day used heats the target.
         let olr_mean = grids
             .values()
             .next()
@@ -588,9 +590,7 @@ fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
         .map_err(|e| DatasetError(format!("{}: cannot write: {e}", path.display())))
 }
 
-/// PNG bytes of an image: `bytes` in native byte order for 16-bit samples (as the
-/// `image` encoders take them), fast deflate with the Sub filter (measured: a third of
-/// the default's encode time for 5 % larger files on these frames).
+/// PNG bytes through [`image_io::encode_png`], errors naming the file.
 fn encode_png(
     bytes: &[u8],
     width: u32,
@@ -598,13 +598,8 @@ fn encode_png(
     colour: image::ExtendedColorType,
     path: &Path,
 ) -> Result<Vec<u8>, DatasetError> {
-    use image::ImageEncoder;
-    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    let mut out = Vec::new();
-    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub)
-        .write_image(bytes, width, height, colour)
-        .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))?;
-    Ok(out)
+    image_io::encode_png(bytes, width, height, colour)
+        .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))
 }
 
 fn record(
@@ -661,8 +656,13 @@ fn write_image(
     let rec = record(file, plan, frame, thermal);
     let (w, h) = (frame.width as u32, frame.height as u32);
     let path = dir.join(&rec.file);
-    let dn_bytes: Vec<u8> = frame.dn.iter().flat_map(|v| v.to_ne_bytes()).collect();
-    let png = encode_png(&dn_bytes, w, h, image::ExtendedColorType::L16, &path)?;
+    let png = encode_png(
+        &image_io::native_bytes(&frame.dn),
+        w,
+        h,
+        image::ExtendedColorType::L16,
+        &path,
+    )?;
     atomic_write(&path, &png)?;
     if options.masks {
         let mask: Vec<u8> = frame
@@ -741,14 +741,7 @@ pub fn write_dataset(
         .map_err(|e| io(&journal_path, e))?;
     let journal = Mutex::new(journal);
     let bar = if options.progress {
-        let bar = ProgressBar::new(todo.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} images ({per_sec}, eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
+        progress::bar(todo.len(), "images")
     } else {
         ProgressBar::hidden()
     };
@@ -799,7 +792,7 @@ pub fn write_dataset(
 fn write_labels<'a>(
     file: &SceneFile,
     dir: &Path,
-    records: impl Iterator<Item = &'a ImageRecord> + Clone,
+    records: impl Iterator<Item = &'a ImageRecord>,
 ) -> Result<(), DatasetError> {
     let mut csv = String::from(
         "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed\n",
