@@ -15,6 +15,7 @@ pub mod geom;
 pub mod image_io;
 pub mod paper;
 pub mod plots;
+pub mod progress;
 pub mod render;
 pub mod run;
 pub mod scene;

@@ -337,6 +337,16 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     })
 }
 
+/// Image point of sub-sample `s` (0..16, row-major) of pixel (x, y): the centres of a
+/// 4 × 4 grid of equal cells.
+fn sample_point(x: usize, y: usize, s: usize) -> (f64, f64) {
+    let step = 1.0 / SUPERSAMPLES_PER_AXIS as f64;
+    (
+        x as f64 + ((s % SUPERSAMPLES_PER_AXIS) as f64 + 0.5) * step,
+        y as f64 + ((s / SUPERSAMPLES_PER_AXIS) as f64 + 0.5) * step,
+    )
+}
+
 /// Tight box of the pixels whose coverage is at least [`MASK_COVERAGE`].
 pub fn mask_box(coverage: &[f32], width: usize) -> Roi {
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
@@ -608,7 +618,6 @@ fn render_target(
     let mut sample_facet = vec![NO_FACET; partial_px.len() * SAMPLES];
     let mut sample_inv_z = vec![0f32; partial_px.len() * SAMPLES];
     if !partial_px.is_empty() {
-        let step = 1.0 / SUPERSAMPLES_PER_AXIS as f64;
         for tri in &tris {
             for y in tri.y.0..tri.y.1 {
                 for x in tri.x.0..tri.x.1 {
@@ -618,8 +627,7 @@ fn render_target(
                     }
                     let base = p as usize * SAMPLES;
                     for s in 0..SAMPLES {
-                        let u = x as f64 + (s % SUPERSAMPLES_PER_AXIS) as f64 * step + step / 2.0;
-                        let v = y as f64 + (s / SUPERSAMPLES_PER_AXIS) as f64 * step + step / 2.0;
+                        let (u, v) = sample_point(x, y, s);
                         if let Some(iz) = tri.inside(u, v) {
                             if iz > sample_inv_z[base + s] {
                                 sample_inv_z[base + s] = iz;
@@ -751,7 +759,6 @@ fn render_earth(
         }
     }
     // Limb pixels (a cast 4-neighbour differs in hit) are supersampled.
-    let step = 1.0 / SUPERSAMPLES_PER_AXIS as f64;
     for y in 0..h {
         for x in 0..w {
             let i = y * w + x;
@@ -767,8 +774,7 @@ fn render_earth(
             let s = if differs {
                 let mut sum = 0f32;
                 for s in 0..SAMPLES {
-                    let u = x as f64 + (s % SUPERSAMPLES_PER_AXIS) as f64 * step + step / 2.0;
-                    let v = y as f64 + (s / SUPERSAMPLES_PER_AXIS) as f64 * step + step / 2.0;
+                    let (u, v) = sample_point(x, y, s);
                     stats.earth_rays += 1;
                     sum += rays.signal(cam.ray(u, v))?.unwrap_or(0.0);
                 }
