@@ -12,7 +12,7 @@ use crate::image_io::read_frame;
 use crate::run::DetectorBank;
 use crate::scene::{self, SceneFile};
 use crate::sensor_view::{self, SensorRequest};
-use crate::{dataset, eval, figure, fixture, paper};
+use crate::{dataset, eval, figure, fixture, paper, progress};
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
@@ -321,13 +321,7 @@ pub fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Demo { repeat, figures } => demo(repeat as usize, figures.as_deref()),
-        Command::Fixtures { out } => match write_fixtures(&out) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("tirroi: error: {e}");
-                ExitCode::from(EXIT_BAD_INPUT)
-            }
-        },
+        Command::Fixtures { out } => exit_code(write_fixtures(&out)),
         Command::Sensor(args) => sensor(&args),
         Command::Eval {
             images,
@@ -341,16 +335,15 @@ pub fn main() -> ExitCode {
             let options = eval::EvalOptions {
                 methods: method.0,
                 repeat: repeat as usize,
-                box_rule,
+                box_rule: Some(box_rule),
                 bits,
             };
-            match run_eval(&images, truth.as_deref(), &options, out.as_deref()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("tirroi: error: {e}");
-                    ExitCode::from(EXIT_BAD_INPUT)
-                }
-            }
+            exit_code(run_eval(
+                &images,
+                truth.as_deref(),
+                &options,
+                out.as_deref(),
+            ))
         }
         Command::Paper {
             out,
@@ -363,47 +356,24 @@ pub fn main() -> ExitCode {
                 figures,
                 full,
                 repeat: repeat as usize,
-                progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+                progress: true,
             };
-            match run_paper(&options) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("tirroi: error: {e}");
-                    ExitCode::from(EXIT_BAD_INPUT)
-                }
-            }
+            exit_code(run_paper(&options))
         }
-        Command::Tune(args) => match crate::tune::run(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("tirroi: error: {e}");
-                ExitCode::from(EXIT_BAD_INPUT)
-            }
-        },
-        Command::Render(args) => match render_dataset(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("tirroi: error: {e}");
-                ExitCode::from(EXIT_BAD_INPUT)
-            }
-        },
+        Command::Tune(args) => exit_code(crate::tune::run(&args)),
+        Command::Render(args) => exit_code(render_dataset(&args)),
     }
 }
 
-/// A progress bar on stderr when it is a terminal (hidden otherwise).
-pub fn progress_bar(len: usize, what: &str) -> indicatif::ProgressBar {
-    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        return indicatif::ProgressBar::hidden();
+/// Success, or the error as one line `tirroi: error: ...` and [`EXIT_BAD_INPUT`].
+fn exit_code(result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("tirroi: error: {e}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
     }
-    let bar = indicatif::ProgressBar::new(len as u64);
-    let template = format!(
-        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {what} ({{per_sec}}, eta {{eta}})"
-    );
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(&template)
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar
 }
 
 fn run_eval(
@@ -414,7 +384,7 @@ fn run_eval(
 ) -> Result<(), String> {
     let truth = truth.map_or_else(|| images.join("truth.csv"), std::path::Path::to_path_buf);
     let rows = eval::read_truth(&truth).map_err(|e| e.to_string())?;
-    let bar = progress_bar(rows.len(), "frames");
+    let bar = progress::bar(rows.len(), "frames");
     let scores = eval::score(images, &rows, options, &DetectorBank::default, &|| {
         bar.inc(1)
     })
@@ -487,7 +457,7 @@ fn render_dataset(args: &RenderArgs) -> Result<(), String> {
         masks: args.masks,
         preview: args.preview,
         resume: args.resume,
-        progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+        progress: true,
     };
     let s = dataset::write_dataset(&file, &args.out, &options).map_err(|e| e.to_string())?;
     let render_s = s.wall_s[1].max(1e-9);

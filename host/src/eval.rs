@@ -163,8 +163,9 @@ pub struct EvalOptions {
     pub methods: Vec<Method>,
     /// Runs per frame and method (median time).
     pub repeat: usize,
-    /// Mask-to-box rule for every detector.
-    pub box_rule: BoxRule,
+    /// Mask-to-box rule for every detector; `None` keeps each detector's own rule from
+    /// `make_bank` (e.g. tuned per method).
+    pub box_rule: Option<BoxRule>,
     /// Bit depth of the frames (None: from the file, 14 for 16-bit files that fit).
     pub bits: Option<u8>,
 }
@@ -186,7 +187,9 @@ pub fn score(
         .map_init(
             || {
                 let mut bank = make_bank();
-                bank.set_box_rule(options.box_rule);
+                if let Some(rule) = options.box_rule {
+                    bank.set_box_rule(rule);
+                }
                 bank
             },
             |bank, row| {

@@ -9,14 +9,13 @@
 
 use std::path::{Path, PathBuf};
 
-use tirroi_core::{BoxRule, Method};
+use tirroi_core::Method;
 
 use crate::dataset::{self, WriteOptions};
 use crate::eval::{self, EvalOptions, FrameScore, TruthRow};
-use crate::run::DetectorBank;
 use crate::scene::SceneFile;
 use crate::tuned::{TunedFor, tuned_bank};
-use crate::{plots, tune};
+use crate::{plots, progress, tune};
 
 /// One row of the paper's Tables 6–8: method, group, mean IoU, median IoU, mean time (ms).
 pub type PaperRow = (&'static str, &'static str, f64, f64, f64);
@@ -131,16 +130,6 @@ fn has(row: &TruthRow, key: &str, value: &str) -> bool {
     row.groups.iter().any(|(k, v)| k == key && v == value)
 }
 
-/// The box rule `bank` gives `method`.
-fn rule_of(bank: &DetectorBank, method: Method) -> BoxRule {
-    match method {
-        Method::Otsu => bank.otsu.box_rule,
-        Method::Adaptive => bank.adaptive.box_rule,
-        Method::Wge => bank.wge.box_rule,
-        Method::Dog => bank.dog.box_rule,
-    }
-}
-
 /// Scores `rows` of `dir` with every method, with the parameters (and box rules) tuned
 /// for `kind`.
 fn score(
@@ -151,25 +140,20 @@ fn score(
     what: &str,
 ) -> Result<Vec<FrameScore>, String> {
     let bar = if options.progress {
-        crate::cli::progress_bar(rows.len() * Method::ALL.len(), what)
+        progress::bar(rows.len(), what)
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let bank = tuned_bank(kind);
-    let mut scores = Vec::new();
-    for m in Method::ALL {
-        let eval_options = EvalOptions {
-            methods: vec![m],
-            repeat: options.repeat,
-            box_rule: rule_of(&bank, m),
-            bits: None,
-        };
-        let s = eval::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
-            bar.inc(1)
-        })
-        .map_err(|e| e.to_string())?;
-        scores.extend(s);
-    }
+    let eval_options = EvalOptions {
+        methods: Method::ALL.to_vec(),
+        repeat: options.repeat,
+        box_rule: None,
+        bits: None,
+    };
+    let scores = eval::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
+        bar.inc(1)
+    })
+    .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     Ok(scores)
 }
@@ -184,14 +168,12 @@ pub fn run(options: &PaperOptions) -> Result<PaperScores, String> {
     } else {
         (Some(1200), Some(300))
     };
-    let paper_dir = options
-        .out
-        .join(if options.full { "paper-full" } else { "paper" });
-    let tango_dir = options
-        .out
-        .join(if options.full { "tango-full" } else { "tango" });
-    // Scores come from the test split only: the tuned parameters were searched on the
-    // disjoint tune split of the same presets (`tune::split`).
+    let DatasetDirs {
+        paper: paper_dir,
+        tango: tango_dir,
+    } = DatasetDirs::of(options);
+    // Scores come from the test split only (`tune::split`), of datasets whose seeds the
+    // tuning never used (`EVAL_SEED_OFFSET`).
     let test = |rows: Vec<TruthRow>| tune::split(&rows, tune::Split::Test);
     let paper_rows = test(dataset("paper", paper_count, &paper_dir, options.progress)?);
     let tango_rows = test(dataset("tango", tango_count, &tango_dir, options.progress)?);

@@ -539,14 +539,14 @@ pub fn evaluate_together(
     sets: &[Params],
     bits: Option<u8>,
 ) -> Result<Vec<Trial>, EvalError> {
-    let Some(first) = sets.first() else {
+    if sets.is_empty() {
         return Ok(Vec::new());
-    };
+    }
     let methods: Vec<Method> = sets.iter().map(Params::method).collect();
     for (k, p) in sets.iter().enumerate() {
-        if methods[..k].contains(&p.method()) || p.box_rule() != first.box_rule() {
+        if methods[..k].contains(&p.method()) {
             return Err(EvalError(format!(
-                "parameter sets scored together need distinct methods and one box rule: {}",
+                "parameter sets scored together need distinct methods: {}",
                 sets.iter()
                     .map(|p| format!("{} {}", p.method(), p.describe()))
                     .collect::<Vec<_>>()
@@ -554,10 +554,11 @@ pub fn evaluate_together(
             )));
         }
     }
+    // Each set brings its own box rule (`Params::apply`).
     let options = EvalOptions {
         methods,
         repeat: 1,
-        box_rule: first.box_rule(),
+        box_rule: None,
         bits,
     };
     let make_bank = || {
@@ -717,6 +718,8 @@ pub fn search(
             });
         }
     }
+    // Largest-component sets first, then all-foreground ones: the scoring order decides
+    // ties (the first scored wins), and the tuned sets in `crate::tuned` came from it.
     for rule in [BoxRule::LargestComponent, BoxRule::AllForeground] {
         let lists: Vec<Vec<Params>> = searches
             .iter()
@@ -863,7 +866,7 @@ pub fn run(args: &TuneArgs) -> Result<(), String> {
     };
     let methods = &args.method.0;
     let planned: usize = methods.iter().map(|&m| grid(m).len()).sum();
-    let bar = crate::cli::progress_bar(planned, "trials");
+    let bar = crate::progress::bar(planned, "trials");
     let start = std::time::Instant::now();
     let result = search(&args.images, &tune_rows, methods, &options, &|_| {
         bar.inc(1);
