@@ -956,16 +956,40 @@ mod tests {
     }
 
     #[test]
-    fn sets_scored_together_need_distinct_methods_and_one_rule() {
-        let dir = Path::new("/nonexistent");
+    fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
         let lc = BoxRule::LargestComponent;
+        let af = BoxRule::AllForeground;
         let a = Params::defaults(Method::Adaptive, lc);
-        let w = Params::defaults(Method::Wge, BoxRule::AllForeground);
-        assert!(evaluate_together(dir, &[], &[a, a], None).is_err());
-        assert!(evaluate_together(dir, &[], &[a, w], None).is_err());
-        let ok = evaluate_together(dir, &[], &[a, Params::defaults(Method::Wge, lc)], None);
-        assert_eq!(ok.map(|t| t.len()), Ok(2));
-        assert_eq!(evaluate_together(dir, &[], &[], None), Ok(Vec::new()));
+        let none = Path::new("/nonexistent");
+        assert!(evaluate_together(none, &[], &[a, a], None).is_err());
+        assert_eq!(evaluate_together(none, &[], &[], None), Ok(Vec::new()));
+
+        // The procedural fixture frames, on disk with their truth.
+        let dir = std::env::temp_dir().join(format!("tirroi-tune-rules-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut rows = Vec::new();
+        for (name, spec) in crate::fixture::standard_set() {
+            let fx = crate::fixture::render(&spec);
+            let file = format!("{name}.png");
+            crate::image_io::write_png16(&dir.join(&file), &fx.frame).unwrap();
+            rows.push(TruthRow {
+                file,
+                roi: fx.truth,
+                groups: Vec::new(),
+                range_m: None,
+            });
+        }
+        // Sets of different rules scored together score as each alone.
+        let sets = [a, Params::defaults(Method::Wge, af)];
+        let together = evaluate_together(&dir, &rows, &sets, None).unwrap();
+        for (p, t) in sets.iter().zip(&together) {
+            let alone = evaluate(&dir, &rows, p, None).unwrap();
+            assert_eq!((&t.params, t.mean_iou), (&alone.params, alone.mean_iou));
+        }
+        // And the rule matters on these frames, so the check above has teeth.
+        let wge_lc = evaluate(&dir, &rows, &Params::defaults(Method::Wge, lc), None).unwrap();
+        assert!((wge_lc.mean_iou - together[1].mean_iou).abs() > 0.05);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
