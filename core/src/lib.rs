@@ -11,6 +11,9 @@
 //! - [`frame`]: a validated, borrowed view of a DN frame ([`Frame`]).
 //! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface and the four detectors
 //!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`].
+//! - `link` (cargo feature `spi`, on by default): frame input over SPI, CRC-checked
+//!   rows read through an embedded-hal 1.0 `SpiDevice` by `link::FrameReader`, and a
+//!   `link::SimulatedCamera` serving a stored frame.
 //!
 //! ## Memory per detector
 //!
@@ -42,6 +45,8 @@
 #![deny(missing_docs)]
 
 pub mod frame;
+#[cfg(feature = "spi")]
+pub mod link;
 pub mod roi;
 pub mod sensor;
 
