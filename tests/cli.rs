@@ -9,6 +9,7 @@ use std::process::Output;
 
 use serde_json::Value;
 use tirroi::core::roi::adaptive::Adaptive;
+use tirroi::core::roi::auto::{Auto, AutoScratch};
 use tirroi::core::roi::dog::{Dog, DogScratch};
 use tirroi::core::roi::otsu::Otsu;
 use tirroi::core::roi::wge::Wge;
@@ -46,6 +47,7 @@ fn library_detection(method: Method, path: &Path) -> Detection {
         Method::Adaptive => Adaptive::default().detect(&frame, &mut Default::default()),
         Method::Wge => Wge::default().detect(&frame, &mut Default::default()),
         Method::Dog => Dog::default().detect(&frame, &mut Box::<DogScratch>::default()),
+        Method::Auto => Auto::default().detect(&frame, &mut Box::<AutoScratch>::default()),
     }
     .expect("default parameters are valid")
 }
@@ -139,20 +141,21 @@ fn detect_json_all_methods_and_files() {
     let out = run(&args);
     assert!(out.status.success(), "{}", stderr_text(&out));
     let lines = stdout_lines(&out);
-    assert_eq!(lines.len(), 4 * files.len(), "{lines:?}");
+    let n = Method::ALL.len();
+    assert_eq!(lines.len(), n * files.len(), "{lines:?}");
     for (i, line) in lines.iter().enumerate() {
         let (f, m, bbox) = parse_line(line);
-        let file = &files[i / 4];
-        let method = Method::ALL[i % 4];
+        let file = &files[i / n];
+        let method = Method::ALL[i % n];
         assert_eq!(f, file.to_str().unwrap());
         assert_eq!(m, method.name());
         let want = library_detection(method, file);
         assert_eq!(bbox, want.roi.map(|r| r.to_array()), "{line}");
     }
-    // The default method is all four.
+    // The default method is all five.
     let out = run(&["detect", "--json", files[0].to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr_text(&out));
-    assert_eq!(stdout_lines(&out).len(), 4);
+    assert_eq!(stdout_lines(&out).len(), n);
 }
 
 #[test]

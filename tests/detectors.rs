@@ -1331,10 +1331,14 @@ fn scratch_memory_budgets() {
 
 #[test]
 fn method_names_round_trip() {
-    assert_eq!(Method::ALL.len(), 4);
+    assert_eq!(Method::ALL.len(), 5);
+    assert_eq!(
+        Method::PAPER,
+        [Method::Otsu, Method::Adaptive, Method::Wge, Method::Dog]
+    );
     for (m, name) in Method::ALL
         .into_iter()
-        .zip(["otsu", "adaptive", "wge", "dog"])
+        .zip(["otsu", "adaptive", "wge", "dog", "auto"])
     {
         assert_eq!(m.name(), name);
         assert_eq!(m.to_string(), name);

@@ -35,7 +35,7 @@ pub struct Cli {
 pub enum Command {
     /// Detect the ROI in 8/16-bit grayscale PNG (or TIFF) frames.
     Detect {
-        /// Detector: otsu, adaptive, wge, dog, or all.
+        /// Detector: otsu, adaptive, wge, dog, auto, or all (the five).
         #[arg(long, default_value = "all", value_parser = parse_methods)]
         method: MethodChoice,
         /// Runs per frame and method; the reported time is the median.
@@ -102,7 +102,7 @@ pub enum Command {
         /// Labels (default: IMAGES/truth.csv), header `file,x0,y0,x1,y1[,extra...]`.
         #[arg(long)]
         truth: Option<PathBuf>,
-        /// Detector: otsu, adaptive, wge, dog, or all.
+        /// Detector: otsu, adaptive, wge, dog, auto, or all (the five).
         #[arg(long, default_value = "all", value_parser = parse_methods)]
         method: MethodChoice,
         /// Runs per frame and method; the reported time is the median.
@@ -284,7 +284,9 @@ fn parse_methods(s: &str) -> Result<MethodChoice, String> {
     }
     Method::from_name(s)
         .map(|m| MethodChoice(vec![m]))
-        .ok_or_else(|| format!("unknown method `{s}`; expected otsu, adaptive, wge, dog or all"))
+        .ok_or_else(|| {
+            format!("unknown method `{s}`; expected otsu, adaptive, wge, dog, auto or all")
+        })
 }
 
 /// The JSON line of `tirroi detect --json` (DESIGN.md).
@@ -610,7 +612,9 @@ fn demo(repeat: usize, figures: Option<&std::path::Path>) -> ExitCode {
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     }
-    println!("tirroi demo: the four detectors on procedural 328x248 14-bit frames");
+    println!(
+        "tirroi demo: the paper's four detectors and `auto` on procedural 328x248 14-bit frames"
+    );
     println!(
         "(not physically rendered: the renderer and the paper's tables come with later work)\n"
     );
@@ -666,12 +670,12 @@ fn demo(repeat: usize, figures: Option<&std::path::Path>) -> ExitCode {
     }
     if let Some(dir) = figures {
         println!(
-            "\nFigures: {}/demo-*.png (green: truth; largest-component boxes: red Otsu, blue adaptive, yellow WGE, magenta DoG).",
+            "\nFigures: {}/demo-*.png (green: truth; largest-component boxes: red Otsu, blue adaptive, yellow WGE, magenta DoG, cyan auto).",
             dir.display()
         );
     }
     println!(
-        "\nTimes are for the all-foreground rule. Scratch memory per detector: `tirroi memory`."
+        "\nTimes are for the all-foreground rule (auto has no box rule: both columns are the same). Scratch memory per detector: `tirroi memory`."
     );
     ExitCode::SUCCESS
 }

@@ -10,8 +10,13 @@ use crate::image_io::{FrameBuf, FrameFileError};
 /// Box colours: truth, then one per detector in `Method::ALL` order.
 pub const TRUTH_COLOUR: [u8; 3] = [0, 220, 0];
 /// Colours of Otsu, adaptive, WGE and DoG boxes.
-pub const METHOD_COLOURS: [[u8; 3]; 4] =
-    [[255, 60, 60], [60, 140, 255], [255, 200, 0], [220, 0, 220]];
+pub const METHOD_COLOURS: [[u8; 3]; 5] = [
+    [255, 60, 60],
+    [60, 140, 255],
+    [255, 200, 0],
+    [220, 0, 220],
+    [0, 230, 230],
+];
 
 /// The frame as an RGB image, DN stretched linearly from the frame's minimum (black)
 /// to its maximum (white), magnified `scale` times, with each box's outline drawn

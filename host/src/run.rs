@@ -3,12 +3,13 @@
 use std::time::Instant;
 
 use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
+use tirroi_core::roi::auto::{Auto, AutoScratch};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
 use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Method};
 
-/// The four detectors with their parameters and their scratch memory (boxed: DoG's
+/// The five detectors with their parameters and their scratch memory (boxed: DoG's
 /// is 70 KiB), ready to run frame after frame.
 #[derive(Default)]
 pub struct DetectorBank {
@@ -20,14 +21,17 @@ pub struct DetectorBank {
     pub wge: Wge,
     /// DoG parameters.
     pub dog: Dog,
+    /// `auto` parameters (its `prior` is used as given: set it for tracking).
+    pub auto: Auto,
     otsu_scratch: Box<OtsuScratch>,
     adaptive_scratch: Box<AdaptiveScratch>,
     wge_scratch: Box<WgeScratch>,
     dog_scratch: Box<DogScratch>,
+    auto_scratch: Box<AutoScratch>,
 }
 
 impl DetectorBank {
-    /// Sets the mask-to-box rule of every detector.
+    /// Sets the mask-to-box rule of every detector (`auto` has none).
     pub fn set_box_rule(&mut self, rule: BoxRule) {
         self.otsu.box_rule = rule;
         self.adaptive.box_rule = rule;
@@ -45,6 +49,7 @@ impl DetectorBank {
             Method::Adaptive => self.adaptive.detect(frame, &mut self.adaptive_scratch),
             Method::Wge => self.wge.detect(frame, &mut self.wge_scratch),
             Method::Dog => self.dog.detect(frame, &mut self.dog_scratch),
+            Method::Auto => self.auto.detect(frame, &mut self.auto_scratch),
         }
     }
 

@@ -40,7 +40,9 @@
 //! | wge | `drop_fraction` × `min_gradient` (Prewitt L1 DN) | {0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 0.995, 0.998} × {0, 48, 128, 256, 512, 1024, 2048, 4096, 8192} |
 //! | dog | `sigma0_px` × `levels` × `min_response_dn` (`sigma_ratio` 1.6) | {2, 4, 8} × {3, 5, 7} × {64, 128, 256, 512, 1024, 2048} (the 6 sets whose widest σ exceeds the core's bound skipped) |
 //!
-//! That is 2 + 126 + 144 + 96 grid sets; the refinement adds some 20–150 trials per
+//! | auto | `coarse_k` × `fine_fraction_q8` (no box rule) | {8, 12, 16, 24} × {64, 86, 128} |
+//!
+//! That is 2 + 126 + 144 + 96 (+ 12 for auto) grid sets; the refinement adds some 20–150 trials per
 //! method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
 //! [`eval::score`] (in parallel, one run each); while the grids run, each pass over
 //! the frames scores one grid set of every method, so a frame is decoded once per pass
@@ -51,6 +53,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use tirroi_core::roi::adaptive::Adaptive;
+use tirroi_core::roi::auto::Auto;
 use tirroi_core::roi::dog::Dog;
 use tirroi_core::roi::otsu::Otsu;
 use tirroi_core::roi::wge::Wge;
@@ -182,6 +185,8 @@ pub enum Params {
     Wge(Wge),
     /// DoG parameters.
     Dog(Dog),
+    /// `auto` parameters (it has no box rule: setting one does nothing).
+    Auto(Auto),
 }
 
 /// The command-line name of a box rule.
@@ -207,6 +212,7 @@ impl Params {
             Method::Adaptive => Params::Adaptive(Adaptive::default()),
             Method::Wge => Params::Wge(Wge::default()),
             Method::Dog => Params::Dog(Dog::default()),
+            Method::Auto => Params::Auto(Auto::default()),
         };
         p.set_box_rule(rule);
         p
@@ -219,6 +225,7 @@ impl Params {
             Method::Adaptive => Params::Adaptive(bank.adaptive),
             Method::Wge => Params::Wge(bank.wge),
             Method::Dog => Params::Dog(bank.dog),
+            Method::Auto => Params::Auto(bank.auto),
         }
     }
 
@@ -229,6 +236,7 @@ impl Params {
             Params::Adaptive(_) => Method::Adaptive,
             Params::Wge(_) => Method::Wge,
             Params::Dog(_) => Method::Dog,
+            Params::Auto(_) => Method::Auto,
         }
     }
 
@@ -239,6 +247,7 @@ impl Params {
             Params::Adaptive(p) => p.box_rule,
             Params::Wge(p) => p.box_rule,
             Params::Dog(p) => p.box_rule,
+            Params::Auto(p) => p.box_rule(),
         }
     }
 
@@ -249,6 +258,7 @@ impl Params {
             Params::Adaptive(p) => p.box_rule = rule,
             Params::Wge(p) => p.box_rule = rule,
             Params::Dog(p) => p.box_rule = rule,
+            Params::Auto(_) => {}
         }
     }
 
@@ -259,6 +269,7 @@ impl Params {
             Params::Adaptive(p) => p.validate().is_ok(),
             Params::Wge(p) => p.validate().is_ok(),
             Params::Dog(p) => p.validate().is_ok(),
+            Params::Auto(p) => p.validate().is_ok(),
         }
     }
 
@@ -269,6 +280,7 @@ impl Params {
             Params::Adaptive(p) => bank.adaptive = p,
             Params::Wge(p) => bank.wge = p,
             Params::Dog(p) => bank.dog = p,
+            Params::Auto(p) => bank.auto = p,
         }
     }
 
@@ -289,6 +301,10 @@ impl Params {
                 "sigma0_px={} sigma_ratio={} levels={} min_response_dn={} box={rule}",
                 p.sigma0_px, p.sigma_ratio, p.levels, p.min_response_dn
             ),
+            Params::Auto(p) => format!(
+                "coarse_k={} fine_k={} fine_fraction_q8={} margin_px={}",
+                p.coarse_k, p.fine_k, p.fine_fraction_q8, p.margin_px
+            ),
         }
     }
 
@@ -298,7 +314,9 @@ impl Params {
         let mut out = Vec::new();
         let mut flipped = *self;
         flipped.set_box_rule(other_rule(self.box_rule()));
-        out.push(flipped);
+        if flipped != *self {
+            out.push(flipped);
+        }
         match *self {
             Params::Otsu(_) => {}
             Params::Adaptive(p) => {
@@ -330,6 +348,20 @@ impl Params {
                 for min_response_dn in steps(&RESPONSE_LADDER, p.min_response_dn) {
                     out.push(Params::Dog(Dog {
                         min_response_dn,
+                        ..p
+                    }));
+                }
+            }
+            Params::Auto(p) => {
+                for coarse_k in steps(&AUTO_K_LADDER, p.coarse_k) {
+                    out.push(Params::Auto(Auto { coarse_k, ..p }));
+                }
+                for fine_k in steps(&AUTO_K_LADDER, p.fine_k) {
+                    out.push(Params::Auto(Auto { fine_k, ..p }));
+                }
+                for fine_fraction_q8 in steps(&AUTO_FRACTION_LADDER, p.fine_fraction_q8) {
+                    out.push(Params::Auto(Auto {
+                        fine_fraction_q8,
                         ..p
                     }));
                 }
@@ -376,6 +408,11 @@ pub const RESPONSE_LADDER: [u32; 17] = [
     16, 32, 48, 64, 96, 128, 192, 256, 384, 512, 768, 1024, 1536, 2048, 3072, 4096, 6144,
 ];
 
+/// Refinement ladder of `auto`'s `coarse_k` and `fine_k` (noise units).
+pub const AUTO_K_LADDER: [u16; 9] = [4, 6, 8, 10, 12, 16, 20, 24, 32];
+/// Refinement ladder of `auto`'s `fine_fraction_q8` (1/256).
+pub const AUTO_FRACTION_LADDER: [u16; 7] = [32, 48, 64, 86, 110, 128, 160];
+
 /// The candidate grid of `method` (see the module documentation): every set of the
 /// grid with the largest-component rule, then every set with the all-foreground rule;
 /// the core defaults are among them; only valid sets.
@@ -405,6 +442,17 @@ pub fn grid(method: Method) -> Vec<Params> {
                 }
             }
         }
+        Method::Auto => {
+            for coarse_k in [8, 12, 16, 24] {
+                for fine_fraction_q8 in [64, 86, 128] {
+                    base.push(Params::Auto(Auto {
+                        coarse_k,
+                        fine_fraction_q8,
+                        ..Auto::default()
+                    }));
+                }
+            }
+        }
         Method::Dog => {
             for sigma0_px in [2.0, 4.0, 8.0] {
                 for levels in [3, 5, 7] {
@@ -427,7 +475,9 @@ pub fn grid(method: Method) -> Vec<Params> {
         for p in &base {
             let mut q = *p;
             q.set_box_rule(rule);
-            out.push(q);
+            if !out.contains(&q) {
+                out.push(q);
+            }
         }
     }
     for rule in [BoxRule::LargestComponent, BoxRule::AllForeground] {
@@ -820,7 +870,9 @@ pub fn parse_method_list(s: &str) -> Result<MethodList, String> {
     }
     Method::from_name(s)
         .map(|m| MethodList(vec![m]))
-        .ok_or_else(|| format!("unknown method `{s}`; expected otsu, adaptive, wge, dog or all"))
+        .ok_or_else(|| {
+            format!("unknown method `{s}`; expected otsu, adaptive, wge, dog, auto or all")
+        })
 }
 
 /// Runs `tirroi tune`: filters the rows, splits them, searches each method on the tune
@@ -952,7 +1004,7 @@ mod tests {
         }
         // The sizes the module documentation gives.
         let sizes = Method::ALL.map(|m| grid(m).len());
-        assert_eq!(sizes, [2, 126, 144, 96]);
+        assert_eq!(sizes, [2, 126, 144, 96, 12]);
     }
 
     #[test]

@@ -24,11 +24,12 @@
 //! Memory is six 82×62 `u16` planes (base, blur temporary, four levels) plus the blob
 //! list and the mask-to-box state: see [`SCRATCH_BYTES`].
 
+use super::plane::{BLOCK, Window, block_means};
 use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
 
 /// Block side of the downsampling, in pixels.
-pub const DOWNSAMPLE: usize = 4;
+pub const DOWNSAMPLE: usize = BLOCK;
 /// Width of the downsampled plane (82 for 328 pixels).
 pub const PLANE_WIDTH: usize = FRAME_WIDTH.div_ceil(DOWNSAMPLE);
 /// Height of the downsampled plane (62 for 248 pixels).
@@ -293,7 +294,12 @@ impl Detector for Dog {
     ) -> u32 {
         let (w, h) = (frame.width(), frame.height());
         let (pw, ph) = (w.div_ceil(DOWNSAMPLE), h.div_ceil(DOWNSAMPLE));
-        downsample(frame, work, pw);
+        block_means(
+            frame,
+            Window::full(frame),
+            &mut work.row_sum,
+            &mut work.base,
+        );
         find_blobs(self, work, pw, ph);
 
         let mut squares = [(0u16, 0u16, 0u16, 0u16); MAX_BLOBS];
@@ -320,33 +326,6 @@ impl Detector for Dog {
             sink(y, mask);
         }
         self.min_response_dn
-    }
-}
-
-/// Block means of the frame into `work.base` (`pw` plane pixels per row).
-fn downsample(frame: &Frame<'_>, work: &mut DogWork, pw: usize) {
-    let max_dn = frame.max_dn();
-    let h = frame.height();
-    let w = frame.width();
-    let row_sum = &mut work.row_sum[..pw];
-    for (py, band) in frame.pixels().chunks(w * DOWNSAMPLE).enumerate() {
-        row_sum.fill(0);
-        for row in band.chunks_exact(w) {
-            let blocks = row.chunks_exact(DOWNSAMPLE);
-            let tail = blocks.remainder();
-            for (acc, block) in row_sum.iter_mut().zip(blocks) {
-                *acc += block.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
-            }
-            if let Some(acc) = row_sum.get_mut(w / DOWNSAMPLE) {
-                *acc += tail.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
-            }
-        }
-        let rows = (h - py * DOWNSAMPLE).min(DOWNSAMPLE);
-        for (px, &s) in row_sum.iter().enumerate() {
-            let cols = (w - px * DOWNSAMPLE).min(DOWNSAMPLE);
-            let n = (rows * cols) as u32;
-            work.base[py * pw + px] = ((s + n / 2) / n) as u16;
-        }
     }
 }
 

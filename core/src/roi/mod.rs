@@ -7,7 +7,9 @@
 //!   full bit depth;
 //! - [`adaptive`]: local-mean threshold over a square block, streaming column sums;
 //! - [`wge`]: weak gradient elimination (Prewitt gradients, drop the weakest fraction);
-//! - [`dog`]: difference-of-Gaussians blob detection over space and scale.
+//! - [`dog`]: difference-of-Gaussians blob detection over space and scale;
+//! - [`auto`]: ours, scene-aware: picks the target's outline among coarse edge
+//!   components and refines it at full resolution, optionally in a tracking window.
 //!
 //! A detector is a small `Copy` parameter struct implementing [`Detector`]; its
 //! working memory is a [`Scratch`] the caller owns, of a size known at compile time.
@@ -15,8 +17,10 @@
 
 mod bbox;
 mod mask;
+mod plane;
 
 pub mod adaptive;
+pub mod auto;
 pub mod dog;
 pub mod otsu;
 pub mod wge;
@@ -150,11 +154,22 @@ pub enum Method {
     Wge,
     /// [`dog::Dog`].
     Dog,
+    /// [`auto::Auto`] (ours, not the paper's).
+    Auto,
 }
 
 impl Method {
-    /// All methods, in the paper's order.
-    pub const ALL: [Method; 4] = [Method::Otsu, Method::Adaptive, Method::Wge, Method::Dog];
+    /// All methods: the paper's four in its order, then `auto`.
+    pub const ALL: [Method; 5] = [
+        Method::Otsu,
+        Method::Adaptive,
+        Method::Wge,
+        Method::Dog,
+        Method::Auto,
+    ];
+
+    /// The paper's four methods, in its order (its tables, figures and tuning).
+    pub const PAPER: [Method; 4] = [Method::Otsu, Method::Adaptive, Method::Wge, Method::Dog];
 
     /// The lower-case name used on the command line.
     pub const fn name(self) -> &'static str {
@@ -163,10 +178,11 @@ impl Method {
             Method::Adaptive => adaptive::Adaptive::NAME,
             Method::Wge => wge::Wge::NAME,
             Method::Dog => dog::Dog::NAME,
+            Method::Auto => auto::Auto::NAME,
         }
     }
 
-    /// Parses a lower-case name (`otsu`, `adaptive`, `wge`, `dog`).
+    /// Parses a lower-case name (`otsu`, `adaptive`, `wge`, `dog`, `auto`).
     pub fn from_name(name: &str) -> Option<Method> {
         Method::ALL.into_iter().find(|m| m.name() == name)
     }
@@ -178,6 +194,7 @@ impl Method {
             Method::Adaptive => adaptive::SCRATCH_BYTES,
             Method::Wge => wge::SCRATCH_BYTES,
             Method::Dog => dog::SCRATCH_BYTES,
+            Method::Auto => auto::SCRATCH_BYTES,
         }
     }
 }

@@ -1,0 +1,797 @@
+//! A scene-aware ROI detector of our own (`auto`): decides from cheap statistics of
+//! the frame what the scene needs, runs only that, and can track (a prior box from
+//! the last frame limits the work to a window around it).
+//!
+//! # Pipeline
+//!
+//! 1. **Plane and noise.** One pass over the frame (or the tracking window) makes the
+//!    4×4 block means ([`super::plane`], shared with DoG): an 82×62 plane. The pixel
+//!    noise σ (DN) is the median absolute difference of horizontal neighbours on every
+//!    fourth row (pairs both at 0 DN or both saturated are skipped: clipped noise says
+//!    nothing), divided by 0.954 (the median of |N(0, 2σ²)| is 0.954 σ).
+//! 2. **Coarse edges.** Prewitt L1 gradients of the plane (WGE's
+//!    [`prewitt_row`](super::wge::prewitt_row) on plane rows); a plane cell is an edge
+//!    cell when its gradient exceeds `coarse_k · σ / 4` (a 16-pixel mean has noise
+//!    σ/4). The Earth's smooth texture and the noise stay below it; the target's sharp
+//!    outline, and the Earth's limb, do not.
+//! 3. **Candidates.** Edge cells are labelled into 8-connected components (at most
+//!    [`MAX_COMPONENTS`]), each with its box, size, summed and largest gradient.
+//! 4. **Target decision.** Each component scores its summed gradient, divided by 8
+//!    for every side of the frame it touches: the limb (a long arc from border to
+//!    border) and Earth patches cut by the frame lose to a compact outline inside it.
+//! 5. **Refinement.** Full-resolution Prewitt gradients inside the winner's box (one
+//!    cell of margin), only at pixels whose cell neighbours the winner. Pixels with
+//!    gradient at least `max(fine_k · σ, gmax · fine_fraction)` (gmax: the winner's
+//!    largest coarse gradient, which for a step equals the full-resolution step
+//!    response) are edge pixels; a step between pixels `a | b` makes both edge
+//!    pixels, so the box of the edge pixels is one pixel too large on every side and
+//!    is shrunk by one.
+//!
+//! # Tracking
+//!
+//! With [`Auto::prior`] set, the pipeline runs on the prior grown by
+//! `margin_px + max(width, height) / 8` on every side. If nothing is found there, or
+//! the winner touches the window's border (the target left the window or grew out of
+//! it), the full frame is processed instead.
+//!
+//! # Budgets
+//!
+//! No heap, no floating point in any loop over pixels or cells (only integer DN, sums
+//! and gradients), no panic on any frame; memory is [`SCRATCH_BYTES`].
+
+use super::plane::{BLOCK, Window};
+use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
+use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
+
+/// Width of the block-mean plane, in cells (82 for 328 pixels).
+pub const GRID_WIDTH: usize = FRAME_WIDTH.div_ceil(BLOCK);
+/// Height of the block-mean plane, in cells (62 for 248 pixels).
+pub const GRID_HEIGHT: usize = FRAME_HEIGHT.div_ceil(BLOCK);
+const GRID: usize = GRID_WIDTH * GRID_HEIGHT;
+/// Most edge components labelled per frame; edge cells that would start a further
+/// component are dropped (a frame that noisy has no outline worth boxing).
+pub const MAX_COMPONENTS: usize = 250;
+/// Bins of the noise histogram (16 exact bins, then 4 per octave up to 2^16).
+const NOISE_BINS: usize = 64;
+
+/// Parameters of the `auto` detector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Auto {
+    /// Tracking prior: the last frame's box, or `None` to search the whole frame.
+    /// Any box is accepted; it is cut to the frame, and an empty result means no prior.
+    pub prior: Option<Roi>,
+    /// Coarse edge threshold in units of the block-mean noise σ/4: 1..=1000.
+    /// Default 12.
+    pub coarse_k: u16,
+    /// Full-resolution edge floor in units of the pixel noise σ: 1..=1000. Default 12.
+    pub fine_k: u16,
+    /// Full-resolution edge threshold as a fraction of the winner's largest gradient,
+    /// in 1/256: 0..=256. Default 86 (one third).
+    pub fine_fraction_q8: u16,
+    /// Tracking window margin around the prior, in pixels: 0..=328. Default 16.
+    pub margin_px: u16,
+}
+
+impl Default for Auto {
+    fn default() -> Self {
+        Auto {
+            prior: None,
+            coarse_k: 12,
+            fine_k: 12,
+            fine_fraction_q8: 86,
+            margin_px: 16,
+        }
+    }
+}
+
+impl Auto {
+    /// The same parameters with a tracking prior (the last frame's box).
+    pub const fn with_prior(self, prior: Option<Roi>) -> Self {
+        Auto { prior, ..self }
+    }
+}
+
+/// Statistics of one component of edge cells.
+#[derive(Debug, Clone, Copy)]
+struct Component {
+    /// Cell box, exclusive ends.
+    x0: u8,
+    y0: u8,
+    x1: u8,
+    y1: u8,
+    /// Edge cells.
+    area: u16,
+    /// Sum of the cells' coarse gradients.
+    energy: u32,
+    /// Largest coarse gradient.
+    gmax: u32,
+}
+
+impl Component {
+    fn add(&mut self, x: u8, y: u8, q: u32) {
+        self.x0 = self.x0.min(x);
+        self.y0 = self.y0.min(y);
+        self.x1 = self.x1.max(x.saturating_add(1));
+        self.y1 = self.y1.max(y.saturating_add(1));
+        self.area = self.area.saturating_add(1);
+        self.energy = self.energy.saturating_add(q);
+        self.gmax = self.gmax.max(q);
+    }
+
+    fn merge(&mut self, o: &Component) {
+        self.x0 = self.x0.min(o.x0);
+        self.y0 = self.y0.min(o.y0);
+        self.x1 = self.x1.max(o.x1);
+        self.y1 = self.y1.max(o.y1);
+        self.area = self.area.saturating_add(o.area);
+        self.energy = self.energy.saturating_add(o.energy);
+        self.gmax = self.gmax.max(o.gmax);
+    }
+}
+
+const NO_COMPONENT: Component = Component {
+    x0: u8::MAX,
+    y0: u8::MAX,
+    x1: 0,
+    y1: 0,
+    area: 0,
+    energy: 0,
+    gmax: 0,
+};
+
+/// `auto`'s buffers: the cell plane (steps, then labels), the component table, and
+/// rows of the refinement.
+#[derive(Debug, Clone)]
+pub struct AutoWork {
+    /// Per cell of the window: the largest neighbour step in σ/4 (clamped to 255),
+    /// then the cell's component label (0: not an edge cell).
+    label: [u8; GRID],
+    parent: [u8; MAX_COMPONENTS + 1],
+    comps: [Component; MAX_COMPONENTS + 1],
+    /// Largest steps of one band of rows per pixel, DN; noise differences of one row;
+    /// then the refinement's step flags of one row.
+    steps: [u16; FRAME_WIDTH],
+    /// Saturated pixels per column and per row of the refinement window.
+    col_sat: [u16; FRAME_WIDTH],
+    row_sat: [u16; FRAME_HEIGHT],
+    hist: [u32; NOISE_BINS],
+    /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
+    /// of [`Detector::foreground`].
+    mask: [bool; FRAME_WIDTH],
+}
+
+/// The `auto` detector's scratch memory.
+pub type AutoScratch = Scratch<AutoWork>;
+
+/// Bytes of [`AutoScratch`] (budget: 32 KiB, checked at compile time).
+pub const SCRATCH_BYTES: usize = core::mem::size_of::<AutoScratch>();
+const _: () = assert!(SCRATCH_BYTES <= 32 * 1024, "auto's scratch exceeds 32 KiB");
+
+impl AutoScratch {
+    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
+    pub const fn new() -> Self {
+        Scratch {
+            work: AutoWork {
+                label: [0; GRID],
+                parent: [0; MAX_COMPONENTS + 1],
+                comps: [NO_COMPONENT; MAX_COMPONENTS + 1],
+                steps: [0; FRAME_WIDTH],
+                col_sat: [0; FRAME_WIDTH],
+                row_sat: [0; FRAME_HEIGHT],
+                hist: [0; NOISE_BINS],
+                mask: [false; FRAME_WIDTH],
+            },
+            roi: RoiBuilder::new(),
+        }
+    }
+}
+
+impl Default for AutoScratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What one pass of the pipeline found in a window.
+#[derive(Debug, Clone, Copy)]
+struct Found {
+    roi: Option<Roi>,
+    /// Coarse edge threshold (Prewitt L1 of block means, DN).
+    threshold: u32,
+    /// Full-resolution edge pixels inside the gate.
+    edge_px: u32,
+    /// The winner touches the window's border.
+    at_window_edge: bool,
+}
+
+/// Noise histogram bin of an absolute difference: exact below 16, then 4 per octave.
+fn noise_bin(d: u32) -> usize {
+    if d < 16 {
+        return d as usize;
+    }
+    let l = 31 - d.leading_zeros(); // 4..=16
+    let sub = (d >> (l - 2)) & 3;
+    (16 + (l - 4) * 4 + sub).min(NOISE_BINS as u32 - 1) as usize
+}
+
+/// The middle of the values of bin `b` (inverse of [`noise_bin`]).
+fn bin_value(b: usize) -> u32 {
+    if b < 16 {
+        return b as u32;
+    }
+    let l = (b as u32 - 16) / 4 + 4;
+    let sub = (b as u32 - 16) % 4;
+    let lo = (4 + sub) << (l - 2);
+    lo + (1 << (l - 2)) / 2
+}
+
+/// Pixel noise σ in DN (≥ 1) of `win`, from horizontal neighbour differences on
+/// at most 16 evenly spaced rows (pairs both at 0 DN or both saturated are skipped).
+fn noise_sigma(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [u32; NOISE_BINS],
+    buf: &mut [u16; FRAME_WIDTH],
+) -> u32 {
+    let max_dn = frame.max_dn();
+    hist.fill(0);
+    let mut n = 0u32;
+    let stride = (win.h / 16).max(1);
+    let mut y = win.y0 + stride / 2;
+    while y < win.y0 + win.h {
+        let row = win.row(frame, y);
+        let d = &mut buf[..row.len().saturating_sub(1)];
+        for ((o, &a), &b) in d.iter_mut().zip(row).zip(row.get(1..).unwrap_or(&[])) {
+            let (a, b) = (a.min(max_dn), b.min(max_dn));
+            let skip = (a | b) == 0 || (a & b) == max_dn;
+            *o = if skip { u16::MAX } else { a.abs_diff(b) };
+        }
+        for &v in d.iter() {
+            if v != u16::MAX {
+                hist[noise_bin(u32::from(v))] += 1;
+                n += 1;
+            }
+        }
+        y += stride;
+    }
+    if n < 16 {
+        return 1;
+    }
+    let mut seen = 0;
+    let median = hist
+        .iter()
+        .position(|&c| {
+            seen += c;
+            2 * seen > n
+        })
+        .map_or(1, bin_value);
+    // σ = median / 0.954.
+    ((median * 21 + 10) / 20).max(1)
+}
+
+/// The outermost boundaries seen by the refinement, and the hull of their pixels.
+#[derive(Debug, Clone, Copy)]
+struct Boundaries {
+    /// Boundaries between columns (from horizontal steps): smallest and largest.
+    bx: (usize, usize),
+    /// Boundaries between rows (from vertical steps): smallest and largest.
+    by: (usize, usize),
+    /// Hull of the step pixels: x range, y range (exclusive ends).
+    hx: (usize, usize),
+    hy: (usize, usize),
+    count: u32,
+}
+
+impl Boundaries {
+    const NONE: Boundaries = Boundaries {
+        bx: (usize::MAX, 0),
+        by: (usize::MAX, 0),
+        hx: (usize::MAX, 0),
+        hy: (usize::MAX, 0),
+        count: 0,
+    };
+
+    fn pixel(&mut self, x: usize, y: usize) {
+        self.hx = (self.hx.0.min(x), self.hx.1.max(x + 1));
+        self.hy = (self.hy.0.min(y), self.hy.1.max(y + 1));
+        self.count += 1;
+    }
+
+    /// A boundary before column `b`, seen on row `y`.
+    fn add_x(&mut self, b: usize, y: usize) {
+        self.bx = (self.bx.0.min(b), self.bx.1.max(b));
+        self.pixel(b.saturating_sub(1), y);
+    }
+
+    /// A boundary before row `b`, seen in column `x`.
+    fn add_y(&mut self, x: usize, b: usize) {
+        self.by = (self.by.0.min(b), self.by.1.max(b));
+        self.pixel(x, b.saturating_sub(1));
+    }
+
+    /// The box between the outermost boundaries (the step pixels' hull along an axis
+    /// without two boundaries).
+    fn roi(&self) -> Option<Roi> {
+        if self.count == 0 {
+            return None;
+        }
+        let (x0, x1) = if self.bx.0 < self.bx.1 {
+            self.bx
+        } else {
+            self.hx
+        };
+        let (y0, y1) = if self.by.0 < self.by.1 {
+            self.by
+        } else {
+            self.hy
+        };
+        Some(Roi::new(x0 as u16, y0 as u16, x1 as u16, y1 as u16))
+    }
+}
+
+/// The box of the saturated pixels from their column and row counts (`col_sat[i]` is
+/// column `x0 + i`), with outermost lines of at most 2 pixels trimmed (twice per
+/// side at most): pixels less than half covered by a saturating target saturate
+/// too, and stick out of the truth box one at a time.
+fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usize) -> Option<Roi> {
+    let span = |counts: &[u16]| {
+        let first = counts.iter().position(|&c| c > 0)?;
+        let last = counts.iter().rposition(|&c| c > 0)?;
+        let (mut a, mut b) = (first, last + 1);
+        for _ in 0..2 {
+            if b - a > 2 && counts[a] <= 2 {
+                a += 1;
+            }
+            if b - a > 2 && counts[b - 1] <= 2 {
+                b -= 1;
+            }
+        }
+        Some((a, b))
+    };
+    let (xa, xb) = span(col_sat)?;
+    let (ya, yb) = span(row_sat)?;
+    Some(Roi::new(
+        (x0 + xa) as u16,
+        (y0 + ya) as u16,
+        (x0 + xb) as u16,
+        (y0 + yb) as u16,
+    ))
+}
+
+/// The step plane of `win` into `plane` (`pw` cells per row): per cell, the largest
+/// absolute difference of a pixel and its right or lower neighbour, in units of σ/4,
+/// clamped to 255. `band` holds the per-pixel maxima of one band of rows.
+fn step_plane(
+    frame: &Frame<'_>,
+    win: Window,
+    sigma: u32,
+    pw: usize,
+    band: &mut [u16; FRAME_WIDTH],
+    plane: &mut [u8],
+) {
+    let max_dn = frame.max_dn();
+    let n = win.w;
+    let band = &mut band[..n];
+    // q = cm · 4/σ, as a 16.16 reciprocal.
+    let inv = (4u64 << 16) / u64::from(sigma.max(1));
+    let c = |v: u16| v.min(max_dn);
+    for (cy, plane_row) in plane.chunks_exact_mut(pw).enumerate() {
+        band.fill(0);
+        let y_end = (win.y0 + (cy + 1) * BLOCK).min(win.y0 + win.h);
+        for y in win.y0 + cy * BLOCK..y_end {
+            let row = win.row(frame, y);
+            let below = if y + 1 < frame.height() {
+                win.row(frame, y + 1)
+            } else {
+                row
+            };
+            if row.len() != n || below.len() != n {
+                continue;
+            }
+            for (((m, &v), &r), &b) in band.iter_mut().zip(row).zip(&row[1..]).zip(below) {
+                let (v, r, b) = (c(v), c(r), c(b));
+                *m = (*m).max(v.abs_diff(r)).max(v.abs_diff(b));
+            }
+            band[n - 1] = band[n - 1].max(c(row[n - 1]).abs_diff(c(below[n - 1])));
+        }
+        for (q, chunk) in plane_row.iter_mut().zip(band.chunks(BLOCK)) {
+            let cm = chunk.iter().fold(0u16, |m, &v| m.max(v));
+            *q = ((u64::from(cm) * inv) >> 16).min(255) as u8;
+        }
+    }
+}
+
+/// Labels the cells of `plane` whose step is at least `threshold` into 8-connected
+/// components (in place, raster order, union-find with statistics merged on union);
+/// other cells become 0. Returns one past the last label used.
+fn label_edges(
+    plane: &mut [u8],
+    pw: usize,
+    ph: usize,
+    threshold: u8,
+    parent: &mut [u8; MAX_COMPONENTS + 1],
+    comps: &mut [Component; MAX_COMPONENTS + 1],
+) -> usize {
+    let mut next = 1usize;
+    for cy in 0..ph {
+        for cx in 0..pw {
+            let i = cy * pw + cx;
+            let q = plane[i];
+            plane[i] = 0;
+            if q < threshold {
+                continue;
+            }
+            let mut l = 0u8;
+            let neighbours = [
+                (cx > 0).then(|| i - 1),
+                (cx > 0 && cy > 0).then(|| i - pw - 1),
+                (cy > 0).then(|| i - pw),
+                (cx + 1 < pw && cy > 0).then(|| i - pw + 1),
+            ];
+            for n in neighbours.into_iter().flatten() {
+                let m = plane[n];
+                if m == 0 {
+                    continue;
+                }
+                let r = find(parent, m);
+                if l == 0 {
+                    l = r;
+                } else if r != l {
+                    let (keep, gone) = if r < l { (r, l) } else { (l, r) };
+                    parent[usize::from(gone)] = keep;
+                    let g = comps[usize::from(gone)];
+                    comps[usize::from(keep)].merge(&g);
+                    l = keep;
+                }
+            }
+            if l == 0 {
+                if next > MAX_COMPONENTS {
+                    continue;
+                }
+                l = next as u8;
+                parent[next] = l;
+                comps[next] = NO_COMPONENT;
+                next += 1;
+            }
+            plane[i] = l;
+            comps[usize::from(l)].add(cx as u8, cy as u8, u32::from(q));
+        }
+    }
+    next
+}
+
+/// Root of component `l`, halving the path.
+fn find(parent: &mut [u8; MAX_COMPONENTS + 1], mut l: u8) -> u8 {
+    loop {
+        let p = parent[usize::from(l)];
+        if p == l {
+            return l;
+        }
+        let g = parent[usize::from(p)];
+        parent[usize::from(l)] = g;
+        l = p;
+    }
+}
+
+impl Auto {
+    /// Runs the pipeline on `win`; `None` when no component is found.
+    fn locate(&self, frame: &Frame<'_>, work: &mut AutoWork, win: Window) -> Option<Found> {
+        let max_dn = frame.max_dn();
+        let fw = frame.width();
+        let (pw, ph) = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
+        let sigma = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
+        let AutoWork {
+            label,
+            parent,
+            comps,
+            steps,
+            col_sat,
+            row_sat,
+            mask,
+            ..
+        } = work;
+        let label = &mut label[..pw * ph];
+        step_plane(frame, win, sigma, pw, steps, label);
+
+        // Edge cells (step ≥ coarse_k·σ), labelled in raster order (8-connected,
+        // union-find on u8 labels, statistics merged on union).
+        let threshold = (u32::from(self.coarse_k) * 4).min(255) as u8;
+        let next = label_edges(label, pw, ph, threshold, parent, comps);
+        // The target decision: summed steps, / 8 per window side touched.
+        let (pw8, ph8) = (pw as u8, ph as u8);
+        let sides = |c: &Component| {
+            u32::from(c.x0 == 0)
+                + u32::from(c.y0 == 0)
+                + u32::from(c.x1 >= pw8)
+                + u32::from(c.y1 >= ph8)
+        };
+        let mut best: Option<(u8, u64)> = None;
+        for l in 1..next {
+            if parent[l] != l as u8 {
+                continue;
+            }
+            let c = &comps[l];
+            let score = u64::from(c.energy) >> (3 * sides(c));
+            if best.is_none_or(|(_, s)| score > s) {
+                best = Some((l as u8, score));
+            }
+        }
+        let (root, _) = best?;
+        let c = comps[usize::from(root)];
+
+        // Refinement at full resolution inside the winner's box plus one cell: a step
+        // of at least τ between pixels x − 1 and x + 1 puts a boundary before x when x
+        // is closer to x + 1, else after it (x goes with the side it resembles: with
+        // half-coverage labels, exactly the truth's boundary). The box spans the
+        // outermost boundaries.
+        let cell_px = |cell: u8| usize::from(cell) * BLOCK;
+        let rx0 = win.x0 + cell_px(c.x0.saturating_sub(1));
+        let ry0 = win.y0 + cell_px(c.y0.saturating_sub(1));
+        let rx1 = (win.x0 + cell_px(c.x1.saturating_add(1))).min(win.x0 + win.w);
+        let ry1 = (win.y0 + cell_px(c.y1.saturating_add(1))).min(win.y0 + win.h);
+        // Labels to roots around the winner, so the gate is one comparison per cell.
+        let (gx0, gx1) = (
+            usize::from(c.x0.saturating_sub(2)),
+            (usize::from(c.x1) + 2).min(pw),
+        );
+        let (gy0, gy1) = (
+            usize::from(c.y0.saturating_sub(2)),
+            (usize::from(c.y1) + 2).min(ph),
+        );
+        for cy in gy0..gy1 {
+            for l in &mut label[cy * pw + gx0..cy * pw + gx1] {
+                if *l != 0 {
+                    *l = find(parent, *l);
+                }
+            }
+        }
+        let tau = (u32::from(self.fine_k) * sigma).min(u32::from(u16::MAX)) as u16;
+        let near_sat = max_dn.saturating_sub((4 * sigma).min(u32::from(u16::MAX)) as u16);
+        let mut all = Boundaries::NONE;
+        let mut unsat = Boundaries::NONE;
+        let (mut sat_px, mut near_px) = (0u32, 0u32);
+        let col_sat = &mut col_sat[rx0..rx1];
+        let row_sat = &mut row_sat[ry0..ry1];
+        col_sat.fill(0);
+        row_sat.fill(0);
+        let flags = &mut steps[rx0..rx1];
+        let gate_px = &mut mask[rx0..rx1];
+        let mut gate_row = usize::MAX;
+        for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
+            let cy = (y - win.y0) / BLOCK;
+            if cy != gate_row {
+                gate_row = cy;
+                let (ya, yb) = (cy.saturating_sub(1), (cy + 2).min(ph));
+                for (x, g) in (rx0..rx1).zip(gate_px.iter_mut()) {
+                    let cx = (x - win.x0) / BLOCK;
+                    let (xa, xb) = (cx.saturating_sub(1), (cx + 2).min(pw));
+                    *g = (ya..yb).any(|gy| (xa..xb).any(|gx| label[gy * pw + gx] == root));
+                }
+            }
+            let Some(row) = frame.row(y) else { continue };
+            let row = &row[..fw];
+            // Saturation counts (gated).
+            let mut near = 0u32;
+            for ((&v, cs), &g) in row[rx0..rx1]
+                .iter()
+                .zip(col_sat.iter_mut())
+                .zip(gate_px.iter())
+            {
+                let v = v.min(max_dn);
+                let sat = u16::from(g && v >= max_dn);
+                *cs += sat;
+                *rs += sat;
+                near += u32::from(g && v >= near_sat && v < max_dn);
+            }
+            sat_px += u32::from(*rs);
+            near_px += near;
+            // Step flags: bit 0 horizontal, bit 1 vertical.
+            flags.fill(0);
+            let (xa, xb) = (rx0.max(1), rx1.min(fw - 1));
+            if xa < xb {
+                let (l, r) = (&row[xa - 1..xb - 1], &row[xa + 1..xb + 1]);
+                for ((f, &a), &b) in flags[xa - rx0..xb - rx0].iter_mut().zip(l).zip(r) {
+                    *f = u16::from(a.min(max_dn).abs_diff(b.min(max_dn)) >= tau);
+                }
+            }
+            let (above, below) = (
+                y.checked_sub(1).and_then(|u| frame.row(u)),
+                frame.row(y + 1),
+            );
+            if let (Some(a), Some(b)) = (above, below) {
+                for ((f, &a), &b) in flags.iter_mut().zip(&a[rx0..rx1]).zip(&b[rx0..rx1]) {
+                    *f |= u16::from(a.min(max_dn).abs_diff(b.min(max_dn)) >= tau) << 1;
+                }
+            }
+            for ((x, &f), &g) in (rx0..rx1).zip(flags.iter()).zip(gate_px.iter()) {
+                if f == 0 || !g {
+                    continue;
+                }
+                let c = row[x].min(max_dn);
+                // Steps that are not the largest along their direction (the small
+                // step between a partly covered pixel and the background beyond it,
+                // noise beside an edge) are not boundaries.
+                if f & 1 != 0 {
+                    let at = |i: usize| row.get(i).map(|&v| v.min(max_dn));
+                    let (l, r) = (row[x - 1].min(max_dn), row[x + 1].min(max_dn));
+                    let step = l.abs_diff(r);
+                    let before = x.checked_sub(2).and_then(at).map_or(0, |v| v.abs_diff(c));
+                    let after = at(x + 2).map_or(0, |v| v.abs_diff(c));
+                    if step >= before && step >= after {
+                        let b = if c.abs_diff(l) >= c.abs_diff(r) {
+                            x
+                        } else {
+                            x + 1
+                        };
+                        all.add_x(b, y);
+                        if l.max(r) < max_dn {
+                            unsat.add_x(b, y);
+                        }
+                    }
+                }
+                if let (true, Some(a), Some(d)) = (f & 2 != 0, above, below) {
+                    let at = |yy: Option<usize>| {
+                        yy.and_then(|yy| frame.row(yy)).map(|r| r[x].min(max_dn))
+                    };
+                    let (u, d) = (a[x].min(max_dn), d[x].min(max_dn));
+                    let step = u.abs_diff(d);
+                    let before = at(y.checked_sub(2)).map_or(0, |v| v.abs_diff(c));
+                    let after = at(Some(y + 2)).map_or(0, |v| v.abs_diff(c));
+                    if step >= before && step >= after {
+                        let b = if c.abs_diff(u) >= c.abs_diff(d) {
+                            y
+                        } else {
+                            y + 1
+                        };
+                        all.add_y(x, b);
+                        if u.max(d) < max_dn {
+                            unsat.add_y(x, b);
+                        }
+                    }
+                }
+            }
+        }
+        let edge_px = all.count;
+        // A saturated target (detection mode) is flat at max_dn: hardly any pixel just
+        // below it, unlike a radiometry face at max_dn with noise.
+        let saturated = sat_px >= 4 && 8 * near_px < sat_px;
+        let roi = if saturated {
+            let sat = saturated_box(col_sat, rx0, row_sat, ry0);
+            sat.map(|s| unsat.roi().map_or(s, |u| s.hull(&u)))
+        } else {
+            all.roi()
+        };
+        roi.map(|roi| Found {
+            roi: Some(roi),
+            threshold: u32::from(self.coarse_k) * sigma,
+            edge_px,
+            at_window_edge: sides(&c) > 0,
+        })
+    }
+
+    /// The detection (box, coarse threshold, edge pixels), tracking window first.
+    fn run(&self, frame: &Frame<'_>, work: &mut AutoWork) -> Detection {
+        let full = Window::full(frame);
+        if let Some(p) = self.prior {
+            let p = p.clip(frame.width() as u16, frame.height() as u16);
+            if !p.is_empty() {
+                let m = usize::from(self.margin_px) + usize::from(p.width().max(p.height())) / 8;
+                let win = Window::clipped(
+                    frame,
+                    usize::from(p.x0).saturating_sub(m),
+                    usize::from(p.y0).saturating_sub(m),
+                    usize::from(p.x1) + m,
+                    usize::from(p.y1) + m,
+                );
+                if let Some(win) = win.filter(|w| !w.is_full(frame)) {
+                    if let Some(f) = self.locate(frame, work, win) {
+                        if !f.at_window_edge {
+                            return detection(f);
+                        }
+                    }
+                }
+            }
+        }
+        match self.locate(frame, work, full) {
+            Some(f) => detection(f),
+            None => Detection {
+                roi: None,
+                threshold: 0,
+                foreground_px: 0,
+            },
+        }
+    }
+}
+
+fn detection(f: Found) -> Detection {
+    Detection {
+        roi: f.roi,
+        threshold: f.threshold,
+        foreground_px: f.edge_px,
+    }
+}
+
+impl Detector for Auto {
+    type Work = AutoWork;
+    const NAME: &'static str = "auto";
+
+    fn validate(&self) -> Result<(), DetectError> {
+        if !(1..=1000).contains(&self.coarse_k) {
+            return Err(DetectError::InvalidParameter {
+                name: "coarse_k",
+                expected: "1..=1000 (units of the block-mean noise)",
+            });
+        }
+        if !(1..=1000).contains(&self.fine_k) {
+            return Err(DetectError::InvalidParameter {
+                name: "fine_k",
+                expected: "1..=1000 (units of the pixel noise)",
+            });
+        }
+        if self.fine_fraction_q8 > 256 {
+            return Err(DetectError::InvalidParameter {
+                name: "fine_fraction_q8",
+                expected: "0..=256 (1/256 of the largest gradient)",
+            });
+        }
+        if usize::from(self.margin_px) > FRAME_WIDTH {
+            return Err(DetectError::InvalidParameter {
+                name: "margin_px",
+                expected: "0..=328 pixels",
+            });
+        }
+        Ok(())
+    }
+
+    /// `auto` always boxes its chosen outline; the rule does not apply.
+    fn box_rule(&self) -> BoxRule {
+        BoxRule::LargestComponent
+    }
+
+    /// Foreground: the detected box, filled. Threshold: the coarse edge threshold
+    /// (Prewitt L1 of 4×4 block means, DN).
+    fn foreground<F: FnMut(usize, &[bool])>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoWork,
+        mut sink: F,
+    ) -> u32 {
+        let d = self.run(frame, work);
+        let roi = d.roi.unwrap_or(Roi::EMPTY);
+        let mask = &mut work.mask[..frame.width()];
+        for y in 0..frame.height() {
+            mask.fill(false);
+            if roi.contains(roi.x0, y as u16) {
+                mask[usize::from(roi.x0)..usize::from(roi.x1)].fill(true);
+            }
+            sink(y, mask);
+        }
+        d.threshold
+    }
+
+    /// Runs `auto` (without the mask pass of the default: the box comes straight from
+    /// the refinement). `foreground_px` counts the edge pixels that made the box.
+    fn detect(
+        &self,
+        frame: &Frame<'_>,
+        scratch: &mut Scratch<AutoWork>,
+    ) -> Result<Detection, DetectError> {
+        self.validate()?;
+        Ok(self.run(frame, &mut scratch.work))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_bins_round_trip() {
+        for d in [0u32, 1, 15, 16, 17, 31, 32, 100, 1000, 16383, 65535] {
+            let b = noise_bin(d);
+            assert!(b < NOISE_BINS);
+            let v = bin_value(b);
+            assert_eq!(noise_bin(v), b, "d {d} bin {b} value {v}");
+        }
+    }
+}

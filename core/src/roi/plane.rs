@@ -1,0 +1,104 @@
+//! Shared helpers for detectors that work on a downsampled plane of block means
+//! ([`super::dog`], [`super::auto`]): a rectangular window of a frame and the
+//! `BLOCK × BLOCK` means of the window's pixels.
+
+use crate::frame::Frame;
+
+/// Block side of the downsampled planes, in pixels.
+pub const BLOCK: usize = 4;
+
+/// A rectangle of a frame in pixels: columns `x0..x0 + w`, rows `y0..y0 + h`.
+///
+/// Built with [`Window::full`] or [`Window::clipped`], so it always lies inside its
+/// frame and is at least 1×1 pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Window {
+    pub x0: usize,
+    pub y0: usize,
+    pub w: usize,
+    pub h: usize,
+}
+
+impl Window {
+    /// The whole frame.
+    pub fn full(frame: &Frame<'_>) -> Window {
+        Window {
+            x0: 0,
+            y0: 0,
+            w: frame.width(),
+            h: frame.height(),
+        }
+    }
+
+    /// `[x0, x1) × [y0, y1)` cut to the frame; `None` when nothing is left.
+    pub fn clipped(
+        frame: &Frame<'_>,
+        x0: usize,
+        y0: usize,
+        x1: usize,
+        y1: usize,
+    ) -> Option<Window> {
+        let (x1, y1) = (x1.min(frame.width()), y1.min(frame.height()));
+        (x0 < x1 && y0 < y1).then_some(Window {
+            x0,
+            y0,
+            w: x1 - x0,
+            h: y1 - y0,
+        })
+    }
+
+    /// The window's part of frame row `y` (a frame row index; empty when outside).
+    pub fn row<'a>(&self, frame: &Frame<'a>, y: usize) -> &'a [u16] {
+        frame
+            .row(y)
+            .and_then(|r| r.get(self.x0..self.x0 + self.w))
+            .unwrap_or(&[])
+    }
+
+    /// True when the window is the whole frame.
+    pub fn is_full(&self, frame: &Frame<'_>) -> bool {
+        self.x0 == 0 && self.y0 == 0 && self.w == frame.width() && self.h == frame.height()
+    }
+}
+
+/// Rounded means of the `BLOCK × BLOCK` blocks of `win` (partial blocks at the right
+/// and bottom edges average the pixels they have), row-major into `out` with
+/// `win.w.div_ceil(BLOCK)` means per row; DN above `max_dn` count as `max_dn`.
+/// `row_sum` needs `win.w.div_ceil(BLOCK)` entries and `out` that times
+/// `win.h.div_ceil(BLOCK)`; shorter buffers leave the means they cannot hold out.
+/// Returns the plane's width and height.
+pub(crate) fn block_means(
+    frame: &Frame<'_>,
+    win: Window,
+    row_sum: &mut [u32],
+    out: &mut [u16],
+) -> (usize, usize) {
+    let max_dn = frame.max_dn();
+    let (w, h) = (win.w, win.h);
+    let (pw, ph) = (w.div_ceil(BLOCK), h.div_ceil(BLOCK));
+    let n = pw.min(row_sum.len());
+    let row_sum = &mut row_sum[..n];
+    for py in 0..ph {
+        row_sum.fill(0);
+        let rows = (h - py * BLOCK).min(BLOCK);
+        for y in win.y0 + py * BLOCK..win.y0 + py * BLOCK + rows {
+            let row = win.row(frame, y);
+            let blocks = row.chunks_exact(BLOCK);
+            let tail = blocks.remainder();
+            for (acc, block) in row_sum.iter_mut().zip(blocks) {
+                *acc += block.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
+            }
+            if let Some(acc) = row_sum.get_mut(w / BLOCK) {
+                *acc += tail.iter().map(|&v| u32::from(v.min(max_dn))).sum::<u32>();
+            }
+        }
+        if let Some(out_row) = out.get_mut(py * pw..(py + 1) * pw) {
+            for (px, (o, &s)) in out_row.iter_mut().zip(row_sum.iter()).enumerate() {
+                let cols = (w - px * BLOCK).min(BLOCK);
+                let n = (rows * cols) as u32;
+                *o = ((s + n / 2) / n) as u16;
+            }
+        }
+    }
+    (pw, ph)
+}

@@ -1,0 +1,286 @@
+//! The `auto` detector: exact boxes on hand-built frames, tracking, memory budget,
+//! parameter errors, and no-panic / box-inside-frame invariants (proptest).
+
+use proptest::prelude::*;
+use tirroi::core::roi::auto::{self, Auto, AutoScratch};
+use tirroi::core::{DetectError, Detector, Frame, Method, Roi};
+
+const W: usize = 328;
+const H: usize = 248;
+
+/// A 328×248 frame from `f(x, y)`.
+fn frame_of(f: impl Fn(usize, usize) -> u16) -> Vec<u16> {
+    (0..W * H).map(|i| f(i % W, i / W)).collect()
+}
+
+fn detect(auto: Auto, px: &[u16]) -> Option<Roi> {
+    let frame = Frame::reference(px).unwrap();
+    let mut s = Box::<AutoScratch>::default();
+    auto.detect(&frame, &mut s).unwrap().roi
+}
+
+/// Deterministic noise in `-amp..=amp` (a hash of the position).
+fn noise(x: usize, y: usize, amp: i32) -> i32 {
+    let mut h = (x as u32).wrapping_mul(0x9E37_79B1) ^ (y as u32).wrapping_mul(0x85EB_CA77);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2C1B_3C6D);
+    h ^= h >> 12;
+    (h % (2 * amp as u32 + 1)) as i32 - amp
+}
+
+#[test]
+fn scratch_fits_32_kib_and_is_static() {
+    static SCRATCH: AutoScratch = AutoScratch::new();
+    const { assert!(auto::SCRATCH_BYTES <= 32 * 1024) };
+    assert_eq!(auto::SCRATCH_BYTES, size_of::<AutoScratch>());
+    assert_eq!(Method::Auto.scratch_bytes(), auto::SCRATCH_BYTES);
+    assert_eq!(size_of_val(&SCRATCH), auto::SCRATCH_BYTES);
+    assert_eq!(Method::from_name("auto"), Some(Method::Auto));
+}
+
+#[test]
+fn bright_box_on_deep_space_is_exact() {
+    let px = frame_of(|x, y| {
+        if (120..225).contains(&x) && (80..150).contains(&y) {
+            9000
+        } else {
+            0
+        }
+    });
+    assert_eq!(
+        detect(Auto::default(), &px),
+        Some(Roi::new(120, 80, 225, 150))
+    );
+}
+
+#[test]
+fn partial_pixels_go_to_the_side_they_resemble() {
+    // Target 5000 on 1000 over columns 40..80, rows 30..60; column 39 is 60 % covered
+    // (in the truth box), column 80 is 30 % covered (not), row 29 is 50 % covered (in),
+    // row 60 is 40 % covered (not).
+    let px = frame_of(|x, y| {
+        let cov_x = match x {
+            39 => 0.6,
+            40..=79 => 1.0,
+            80 => 0.3,
+            _ => 0.0,
+        };
+        let cov_y = match y {
+            29 => 0.5,
+            30..=59 => 1.0,
+            60 => 0.4,
+            _ => 0.0,
+        };
+        (1000.0 + 4000.0 * cov_x * cov_y) as u16
+    });
+    assert_eq!(detect(Auto::default(), &px), Some(Roi::new(39, 29, 80, 60)));
+}
+
+/// A dark target (500 DN) in front of a smooth, noisy Earth that fills the frame
+/// below a straight limb at row 200 (deep space above it).
+fn earth_scene(x: usize, y: usize) -> u16 {
+    let target = (150..190).contains(&x) && (60..110).contains(&y)
+        || (190..230).contains(&x) && (75..95).contains(&y);
+    let v = if target {
+        500
+    } else if y >= 30 {
+        4000 + 8 * x as i32 + 6 * y as i32 + ((x as f64 / 9.0).sin() * 300.0) as i32
+    } else {
+        40
+    };
+    (v + noise(x, y, 20)).clamp(0, 16383) as u16
+}
+
+#[test]
+fn dark_target_on_textured_earth_beats_the_limb() {
+    let px = frame_of(earth_scene);
+    assert_eq!(
+        detect(Auto::default(), &px),
+        Some(Roi::new(150, 60, 230, 110))
+    );
+}
+
+#[test]
+fn saturated_target_drops_single_pixel_ears() {
+    // Detection mode: target saturates; two partly covered pixels saturate too and
+    // stick out of the truth box by one pixel (top and right).
+    let px = frame_of(|x, y| {
+        let body = (100..106).contains(&x) && (50..55).contains(&y);
+        let ear = (x, y) == (102, 49) || (x, y) == (106, 52);
+        if body || ear {
+            16383
+        } else {
+            (300 + noise(x, y, 10)) as u16
+        }
+    });
+    assert_eq!(
+        detect(Auto::default(), &px),
+        Some(Roi::new(100, 50, 106, 55))
+    );
+}
+
+#[test]
+fn tracking_window_gives_the_full_frame_box() {
+    let px = frame_of(earth_scene);
+    let full = detect(Auto::default(), &px);
+    for prior in [
+        Roi::new(150, 60, 230, 110),
+        Roi::new(145, 58, 226, 112),
+        Roi::new(155, 64, 232, 104),
+    ] {
+        assert_eq!(
+            detect(Auto::default().with_prior(Some(prior)), &px),
+            full,
+            "{prior:?}"
+        );
+    }
+}
+
+#[test]
+fn wrong_prior_falls_back_to_the_full_frame() {
+    let px = frame_of(earth_scene);
+    let full = detect(Auto::default(), &px);
+    for prior in [
+        Roi::new(10, 150, 40, 180),   // Earth only
+        Roi::new(0, 0, 20, 10),       // deep space only
+        Roi::new(160, 70, 180, 90),   // inside the target: it leaves the window
+        Roi::new(400, 300, 500, 400), // outside the frame
+        Roi::new(200, 100, 100, 50),  // empty
+    ] {
+        assert_eq!(
+            detect(Auto::default().with_prior(Some(prior)), &px),
+            full,
+            "{prior:?}"
+        );
+    }
+}
+
+#[test]
+fn flat_and_extreme_frames_find_nothing_and_do_not_panic() {
+    for v in [0u16, 1, 8000, 16383, 65535] {
+        let px = vec![v; W * H];
+        assert_eq!(detect(Auto::default(), &px), None, "constant {v}");
+    }
+    let mut hot = vec![100u16; W * H];
+    hot[120 * W + 200] = 16383;
+    let r = detect(Auto::default(), &hot).expect("one hot pixel is a step");
+    assert!(r.contains(200, 120), "{r:?}");
+}
+
+#[test]
+fn bad_parameters_are_errors() {
+    let frame_px = vec![0u16; W * H];
+    let frame = Frame::reference(&frame_px).unwrap();
+    let mut s = Box::<AutoScratch>::default();
+    let bad = [
+        (
+            Auto {
+                coarse_k: 0,
+                ..Auto::default()
+            },
+            "coarse_k",
+        ),
+        (
+            Auto {
+                fine_k: 1001,
+                ..Auto::default()
+            },
+            "fine_k",
+        ),
+        (
+            Auto {
+                fine_fraction_q8: 257,
+                ..Auto::default()
+            },
+            "fine_fraction_q8",
+        ),
+        (
+            Auto {
+                margin_px: 329,
+                ..Auto::default()
+            },
+            "margin_px",
+        ),
+    ];
+    for (a, name) in bad {
+        match a.detect(&frame, &mut s) {
+            Err(DetectError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn small_and_odd_frames() {
+    let mut s = Box::<AutoScratch>::default();
+    for (w, h) in [(1, 1), (2, 3), (5, 1), (7, 9), (328, 1), (1, 248), (13, 17)] {
+        let px: Vec<u16> = (0..w * h).map(|i| ((i * 7919) % 16384) as u16).collect();
+        let f = Frame::new(&px, w, h, 14).unwrap();
+        let d = Auto::default().detect(&f, &mut s).unwrap();
+        if let Some(r) = d.roi {
+            assert!(Roi::new(0, 0, w as u16, h as u16).contains_roi(&r), "{r:?}");
+            assert!(!r.is_empty());
+        }
+    }
+}
+
+fn arb_frame() -> impl Strategy<Value = (usize, usize, u8, Vec<u16>)> {
+    (1usize..=48, 1usize..=40, 1u8..=16).prop_flat_map(|(w, h, bits)| {
+        (
+            Just(w),
+            Just(h),
+            Just(bits),
+            prop::collection::vec(
+                prop_oneof![any::<u16>(), Just(0u16), Just(u16::MAX), 0u16..64],
+                w * h,
+            ),
+        )
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn any_frame_and_prior_gives_a_box_inside_the_frame(
+        (w, h, bits, px) in arb_frame(),
+        prior in prop::option::of((0u16..400, 0u16..300, 0u16..400, 0u16..300)),
+        coarse_k in 1u16..=40,
+        fine_k in 1u16..=40,
+    ) {
+        let f = Frame::new(&px, w, h, bits).unwrap();
+        let mut s = AutoScratch::new();
+        let a = Auto {
+            prior: prior.map(|(a, b, c, d)| Roi::new(a, b, c, d)),
+            coarse_k,
+            fine_k,
+            ..Auto::default()
+        };
+        let d = a.detect(&f, &mut s).unwrap();
+        if let Some(r) = d.roi {
+            prop_assert!(!r.is_empty());
+            prop_assert!(Roi::new(0, 0, w as u16, h as u16).contains_roi(&r), "{:?}", r);
+        }
+        // The same scratch again gives the same answer (no state leaks between frames).
+        prop_assert_eq!(a.detect(&f, &mut s).unwrap(), d);
+    }
+
+    #[test]
+    fn full_size_random_scenes_never_panic(
+        seed in any::<u32>(),
+        x0 in 0usize..320, y0 in 0usize..240, tw in 1usize..200, th in 1usize..200,
+        bg in 0u16..16384, fg in 0u16..16384, amp in 0i32..2000,
+        prior in prop::option::of((0u16..330, 0u16..250, 0u16..330, 0u16..250)),
+    ) {
+        let px = frame_of(|x, y| {
+            let v = if (x0..x0 + tw).contains(&x) && (y0..y0 + th).contains(&y) { fg } else { bg };
+            (i32::from(v) + noise(x ^ seed as usize, y, amp)).clamp(0, 16383) as u16
+        });
+        let f = Frame::reference(&px).unwrap();
+        let mut s = Box::<AutoScratch>::default();
+        let a = Auto::default().with_prior(prior.map(|(a, b, c, d)| Roi::new(a, b, c, d)));
+        if let Some(r) = a.detect(&f, &mut s).unwrap().roi {
+            prop_assert!(Roi::new(0, 0, 328, 248).contains_roi(&r), "{:?}", r);
+        }
+    }
+}
