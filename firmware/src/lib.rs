@@ -1,0 +1,199 @@
+//! # tirroi-firmware
+//!
+//! The flight demo's workload, the same on the emulated Cortex-M7 (`src/main.rs`) and
+//! on the host (`examples/host.rs`, the reference the firmware's boxes are compared
+//! with and the program callgrind counts x86 instructions in):
+//!
+//! 1. every embedded frame ([`frames::FRAMES`], rendered by the host) is streamed in
+//!    through the SPI frame link of the core ([`tirroi_core::link`]) from a simulated
+//!    camera into the one frame buffer, with one corrupted row to show a retry;
+//! 2. every detector of the core runs on it ([`detectors::Detectors`]);
+//! 3. the camera model makes a frame on board ([`synth`]: band radiance table, DN map,
+//!    noise, row by row into the same buffer), and the detectors run on that too.
+//!
+//! Each step is measured by a [`Meter`] (instructions and stack depth on the target,
+//! nothing on the host) and reported as an [`Event`], one text line each.
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod detectors;
+pub mod frames;
+pub mod report;
+pub mod synth;
+
+use core::hint::black_box;
+
+use tirroi_core::Frame;
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+use tirroi_core::link::{FrameReader, SimulatedCamera};
+
+pub use detectors::{DEMO_METHODS, Detectors};
+pub use report::{Event, MeterReading};
+
+/// Bit depth of every frame of the demo (the renderer's and the camera's).
+pub const BITS: u8 = 14;
+
+/// The embedded frame whose row [`RETRY_ROW`] the simulated camera corrupts once, so
+/// the link has to re-request it.
+pub const RETRY_FRAME: usize = 1;
+/// See [`RETRY_FRAME`].
+pub const RETRY_ROW: u16 = 100;
+
+/// Measures one step: instructions and stack depth on the target.
+pub trait Meter {
+    /// Prepares the measurement (e.g. paints the free stack) and starts counting.
+    /// Called right before the measured call, from the same stack frame.
+    fn start(&mut self);
+    /// Stops counting and returns what was measured since [`Meter::start`].
+    fn stop(&mut self) -> MeterReading;
+}
+
+/// A [`Meter`] that measures nothing (the host reference).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoMeter;
+
+impl Meter for NoMeter {
+    fn start(&mut self) {}
+    fn stop(&mut self) -> MeterReading {
+        MeterReading::default()
+    }
+}
+
+/// Everything the demo needs besides the code: one frame buffer, the detectors'
+/// scratch memory and the camera model's tables, borrowed from the caller (statics on
+/// the target, so each lands in `.bss` or `.data` and is counted in the ELF's sizes).
+pub struct Workspace<'a> {
+    /// The one frame buffer, row-major DN (162 688 bytes).
+    pub frame: &'a mut [u16; FRAME_PIXELS],
+    /// The detectors with their scratch memory.
+    pub detectors: &'a mut Detectors,
+    /// The camera model's tables (built on board by [`synth::setup`]).
+    pub tables: &'a mut synth::Tables,
+}
+
+/// Runs the whole demo and hands each [`Event`] to `emit`, in order.
+pub fn run_demo<M: Meter>(ws: &mut Workspace<'_>, meter: &mut M, emit: &mut dyn FnMut(&Event)) {
+    emit(&Event::Start {
+        frames: frames::FRAMES.len(),
+        methods: DEMO_METHODS.len(),
+    });
+    for &method in DEMO_METHODS {
+        emit(&Event::Memory {
+            method,
+            scratch_bytes: Detectors::scratch_bytes(method),
+        });
+    }
+    for (index, embedded) in frames::FRAMES.iter().enumerate() {
+        let Ok(mut camera) = SimulatedCamera::new(embedded.be_bytes, FRAME_WIDTH, FRAME_HEIGHT)
+        else {
+            emit(&Event::Error {
+                frame: embedded.name,
+                what: "embedded frame is not 328x248 DN",
+            });
+            continue;
+        };
+        if index == RETRY_FRAME {
+            camera.corrupt_row_once(RETRY_ROW);
+        }
+        meter.start();
+        let read = black_box(receive_frame(camera, ws.frame));
+        let reading = meter.stop();
+        match read {
+            Ok(stats) => emit(&Event::Link {
+                frame: embedded.name,
+                rows: stats.rows,
+                retries: stats.retries,
+                meter: reading,
+            }),
+            Err(_) => {
+                emit(&Event::Error {
+                    frame: embedded.name,
+                    what: "SPI frame link failed",
+                });
+                continue;
+            }
+        }
+        detect_all(ws, embedded.name, Some(embedded.truth), meter, emit);
+    }
+
+    // The camera model on board: tables, then a frame of radiance → DN + noise.
+    meter.start();
+    synth::setup(ws);
+    let setup = meter.stop();
+    meter.start();
+    let radiance = black_box(synth::radiance_only(ws));
+    let radiance_meter = meter.stop();
+    meter.start();
+    let made = black_box(synth::expose_scene(ws));
+    let expose = meter.stop();
+    match made.and(radiance) {
+        Ok(()) => {
+            emit(&Event::Sensor {
+                checksum: synth::checksum(&ws.frame[..]),
+                setup,
+                radiance: radiance_meter,
+                expose,
+            });
+            detect_all(ws, synth::NAME, None, meter, emit);
+        }
+        Err(_) => emit(&Event::Error {
+            frame: synth::NAME,
+            what: "camera model refused its input",
+        }),
+    }
+    emit(&Event::Done);
+}
+
+/// Streams one frame from `camera` into `frame` through the core's SPI frame reader.
+/// Never inlined, so that its stack is measured as its own.
+#[inline(never)]
+fn receive_frame(
+    camera: SimulatedCamera<'_>,
+    frame: &mut [u16; FRAME_PIXELS],
+) -> Result<tirroi_core::link::ReadStats, tirroi_core::link::LinkError<tirroi_core::link::SimError>>
+{
+    FrameReader::new(camera).read_frame(&mut frame[..], FRAME_WIDTH, FRAME_HEIGHT)
+}
+
+/// Runs every method of [`DEMO_METHODS`] on the frame in `ws.frame`.
+fn detect_all<M: Meter>(
+    ws: &mut Workspace<'_>,
+    name: &'static str,
+    truth: Option<tirroi_core::Roi>,
+    meter: &mut M,
+    emit: &mut dyn FnMut(&Event),
+) {
+    let Workspace {
+        frame, detectors, ..
+    } = ws;
+    let frame: &[u16] = &frame[..];
+    let frame = match Frame::new(frame, FRAME_WIDTH, FRAME_HEIGHT, BITS) {
+        Ok(frame) => frame,
+        Err(_) => {
+            emit(&Event::Error {
+                frame: name,
+                what: "frame does not fit 14 bits",
+            });
+            return;
+        }
+    };
+    for &method in DEMO_METHODS {
+        meter.start();
+        let result = black_box(detectors.run(method, &frame));
+        let reading = meter.stop();
+        match result {
+            Ok(detection) => emit(&Event::Detect {
+                frame: name,
+                method,
+                roi: detection.roi,
+                foreground_px: detection.foreground_px,
+                iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),
+                meter: reading,
+            }),
+            Err(_) => emit(&Event::Error {
+                frame: name,
+                what: "detector refused its parameters",
+            }),
+        }
+    }
+}

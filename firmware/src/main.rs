@@ -1,0 +1,296 @@
+//! The flight demo on a Cortex-M7 (QEMU `mps2-an500`; see scripts/flight.sh): runs
+//! [`tirroi_firmware::run_demo`] and prints every event over semihosting (text, or
+//! defmt frames with `--features defmt`), with the instructions and the stack depth
+//! of each step, then exits through semihosting with status 0, or 1 if a step failed.
+//!
+//! Instructions: the SysTick counts the processor clock; under `qemu-system-arm
+//! -icount shift=0` every guest instruction advances the virtual clock by 1 ns, and the
+//! mps2 boards clock the SysTick at 25 MHz, so a SysTick tick is 40 instructions
+//! ([`INSTRUCTIONS_PER_TICK`], checked at start-up against a loop of known length).
+//! The counter's own cost is measured and subtracted. Counts are exact to ± 40.
+//!
+//! Stack: before each step the free RAM between the end of the statics and the stack
+//! pointer is painted with a pattern; after it, the lowest overwritten word gives the
+//! step's deepest stack use.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod target {
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use cortex_m::peripheral::SYST;
+    use cortex_m::peripheral::syst::SystClkSource;
+    use cortex_m_rt::{entry, exception};
+    #[cfg(feature = "defmt")]
+    use defmt_semihosting as _;
+    use panic_semihosting as _;
+    use tirroi_core::frame::FRAME_PIXELS;
+    use tirroi_firmware::synth::Tables;
+    use tirroi_firmware::{Detectors, Event, Meter, MeterReading, Workspace, run_demo};
+
+    /// Instructions per SysTick tick under `-icount shift=0` (1 ns per instruction,
+    /// SysTick at the 25 MHz system clock of the mps2 boards).
+    const INSTRUCTIONS_PER_TICK: u64 = 40;
+    /// The SysTick reload value: the full 24 bits.
+    const RELOAD: u32 = 0x00FF_FFFF;
+    /// The stack paint pattern.
+    const PAINT: u32 = 0xC5AC_CE55;
+    /// Bytes below the stack pointer left unpainted when a measurement starts (the
+    /// painting function's own frame).
+    const PAINT_MARGIN: usize = 64;
+
+    /// SysTick wraps since start-up (written by the SysTick handler only).
+    static WRAPS: AtomicU32 = AtomicU32::new(0);
+
+    #[exception]
+    fn SysTick() {
+        // Single writer: a load and a store are enough, and ARMv6-M has no RMW atomics.
+        WRAPS.store(
+            WRAPS.load(Ordering::Relaxed).wrapping_add(1),
+            Ordering::Relaxed,
+        );
+    }
+
+    /// SysTick ticks since start-up, 64-bit.
+    fn ticks() -> u64 {
+        loop {
+            let before = WRAPS.load(Ordering::SeqCst);
+            let current = SYST::get_current();
+            let after = WRAPS.load(Ordering::SeqCst);
+            if before == after {
+                return u64::from(before) * (u64::from(RELOAD) + 1) + u64::from(RELOAD - current);
+            }
+        }
+    }
+
+    unsafe extern "C" {
+        /// End of the statics (.bss / .uninit), from cortex-m-rt's link.x: the bottom
+        /// of the free RAM the stack grows into.
+        static mut __sheap: u32;
+        /// The initial stack pointer: ORIGIN(RAM) + LENGTH(RAM) by default.
+        static mut _stack_start: u32;
+    }
+
+    fn free_ram_bottom() -> usize {
+        (&raw const __sheap) as usize
+    }
+
+    /// The initial stack pointer (top of RAM in memory.x), from cortex-m-rt's link.x.
+    fn stack_top() -> usize {
+        (&raw const _stack_start) as usize
+    }
+
+    /// Counts instructions with the SysTick and measures stack depth by painting.
+    struct QemuMeter {
+        start_ticks: u64,
+        sp_at_start: usize,
+        /// Lowest address the stack reached since the first measurement.
+        lowest: usize,
+        /// Instructions a `start`/`stop` pair costs with nothing between them.
+        overhead: u64,
+    }
+
+    impl QemuMeter {
+        fn new() -> Self {
+            let mut meter = QemuMeter {
+                start_ticks: 0,
+                sp_at_start: 0,
+                lowest: usize::MAX,
+                overhead: 0,
+            };
+            // The overhead, the least of a few empty measurements.
+            let mut least = u64::MAX;
+            for _ in 0..8 {
+                meter.start();
+                let r = meter.stop();
+                least = least.min(r.instructions.unwrap_or(0));
+            }
+            meter.overhead = least;
+            meter
+        }
+
+        fn paint(&mut self) {
+            // What ran since the last measurement (reporting) used the painted stack too.
+            if self.sp_at_start != 0 {
+                self.lowest = self.lowest.min(self.lowest_touched());
+            }
+            let sp = cortex_m::register::msp::read() as usize;
+            self.sp_at_start = sp;
+            let bottom = free_ram_bottom();
+            let top = sp.saturating_sub(PAINT_MARGIN) & !3;
+            let mut addr = (bottom + 3) & !3;
+            while addr < top {
+                // SAFETY: [bottom, sp − margin) is RAM that neither the statics (below
+                // `__sheap`) nor any live stack frame (at or above `sp`, the margin
+                // covering this function's own frame) uses; the pattern is only read
+                // back by `stack_used`. Needed to measure stack depth, which is the
+                // point of this demo.
+                unsafe { core::ptr::write_volatile(addr as *mut u32, PAINT) };
+                addr += 4;
+            }
+        }
+
+        /// The lowest word of the painted region that is no longer the pattern.
+        fn lowest_touched(&self) -> usize {
+            let mut addr = (free_ram_bottom() + 3) & !3;
+            let top = self.sp_at_start.saturating_sub(PAINT_MARGIN) & !3;
+            while addr < top {
+                // SAFETY: reads back the words `paint` wrote, in the same free RAM.
+                if unsafe { core::ptr::read_volatile(addr as *const u32) } != PAINT {
+                    break;
+                }
+                addr += 4;
+            }
+            addr
+        }
+
+        fn stack_used(&mut self) -> u32 {
+            let lowest = self.lowest_touched();
+            self.lowest = self.lowest.min(lowest);
+            (self.sp_at_start - lowest) as u32
+        }
+    }
+
+    impl Meter for QemuMeter {
+        #[inline(never)]
+        fn start(&mut self) {
+            self.paint();
+            self.start_ticks = ticks();
+        }
+
+        #[inline(never)]
+        fn stop(&mut self) -> MeterReading {
+            let end = ticks();
+            let instructions =
+                ((end - self.start_ticks) * INSTRUCTIONS_PER_TICK).saturating_sub(self.overhead);
+            MeterReading {
+                instructions: Some(instructions),
+                stack_bytes: Some(self.stack_used()),
+            }
+        }
+    }
+
+    /// Checks [`INSTRUCTIONS_PER_TICK`]: counts a loop of 2 instructions × N.
+    fn calibrate(meter: &mut QemuMeter) -> (u64, u64) {
+        const ITERATIONS: u32 = 1_000_000;
+        meter.start();
+        // SAFETY: a register-only countdown loop (subs + bne per iteration): no memory,
+        // no stack. Needed because only a loop of known length checks the counter.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "subs {n}, {n}, #1",
+                "bne 2b",
+                n = inout(reg) ITERATIONS => _,
+                options(nomem, nostack),
+            );
+        }
+        let counted = meter.stop().instructions.unwrap_or(0);
+        (2 * u64::from(ITERATIONS), counted)
+    }
+
+    #[cfg(not(feature = "defmt"))]
+    fn emit(event: &Event) {
+        cortex_m_semihosting::hprintln!("{}", event);
+    }
+
+    #[cfg(feature = "defmt")]
+    fn emit(event: &Event) {
+        defmt::println!("{}", event);
+    }
+
+    #[cfg(not(feature = "defmt"))]
+    fn report_calibration(expected: u64, counted: u64, overhead: u64) {
+        cortex_m_semihosting::hprintln!(
+            "calibration loop_insns={expected} counted={counted} overhead={overhead}"
+        );
+    }
+
+    #[cfg(feature = "defmt")]
+    fn report_calibration(expected: u64, counted: u64, overhead: u64) {
+        defmt::println!(
+            "calibration loop_insns={=u64} counted={=u64} overhead={=u64}",
+            expected,
+            counted,
+            overhead
+        );
+    }
+
+    #[cfg(not(feature = "defmt"))]
+    fn report_ram(statics_end: usize, stack_top: usize, peak: usize, never_used: usize) {
+        cortex_m_semihosting::hprintln!(
+            "ram statics_end={statics_end:#x} stack_top={stack_top:#x} stack_peak={peak} free_never_used={never_used}"
+        );
+    }
+
+    #[cfg(feature = "defmt")]
+    fn report_ram(statics_end: usize, stack_top: usize, peak: usize, never_used: usize) {
+        defmt::println!(
+            "ram statics_end={=usize:x} stack_top={=usize:x} stack_peak={=usize} free_never_used={=usize}",
+            statics_end,
+            stack_top,
+            peak,
+            never_used
+        );
+    }
+
+    #[entry]
+    fn main() -> ! {
+        // cortex-m-rt turns `static mut` items of the entry function into safe
+        // `&'static mut` references: the buffers are statics, not on the stack. The
+        // frame is zeros (.bss); the scratch holds non-zero initial values (.data).
+        static mut FRAME: [u16; FRAME_PIXELS] = [0; FRAME_PIXELS];
+        static mut DETECTORS: Detectors = Detectors::new();
+        static mut TABLES: Tables = Tables::new();
+
+        let mut core = cortex_m::Peripherals::take().expect("first and only take");
+        core.SYST.set_clock_source(SystClkSource::Core);
+        core.SYST.set_reload(RELOAD);
+        core.SYST.clear_current();
+        core.SYST.enable_interrupt();
+        core.SYST.enable_counter();
+
+        let mut meter = QemuMeter::new();
+        let (expected, counted) = calibrate(&mut meter);
+        report_calibration(expected, counted, meter.overhead);
+
+        let mut failed = false;
+        let mut workspace = Workspace {
+            frame: FRAME,
+            detectors: DETECTORS,
+            tables: TABLES,
+        };
+        run_demo(&mut workspace, &mut meter, &mut |event| {
+            failed |= event.is_error();
+            emit(event);
+        });
+        // One more paint/scan pair closes the last reporting interval.
+        meter.start();
+        meter.stop();
+        let top = stack_top();
+        report_ram(
+            free_ram_bottom(),
+            top,
+            top - meter.lowest,
+            meter.lowest - free_ram_bottom(),
+        );
+        let status = if failed {
+            cortex_m_semihosting::debug::EXIT_FAILURE
+        } else {
+            cortex_m_semihosting::debug::EXIT_SUCCESS
+        };
+        cortex_m_semihosting::debug::exit(status);
+        loop {
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!(
+        "tirroi-firmware is a Cortex-M binary: build and run it with scripts/flight.sh; \
+         on the host, run `cargo run --release --example host` in firmware/"
+    );
+    std::process::exit(2);
+}

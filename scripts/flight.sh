@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# The flight demo (firmware/) end to end, as CI runs it:
+#  1. host reference: `tirroi detect --method all --json` on the embedded frames, and the
+#     firmware's own workload on the host (firmware/examples/host.rs);
+#  2. for each Arm target: build the firmware (release, -Zbuild-std=core, Debian's cargo),
+#     take its section sizes, run it on QEMU's Cortex-M7 (mps2-an500, semihosting,
+#     -icount shift=0 so the SysTick counts instructions);
+#  3. x86-64 instruction counts of the same calls under valgrind's callgrind;
+#  4. firmware/examples/flight_report.rs compares boxes (bit for bit against the host),
+#     the on-board sensor checksums (every target against the host), checks the memory
+#     budgets of memory.x, and writes the tables to $out/report.md.
+# Exits non-zero when a build, a run, a comparison or a budget fails.
+#
+# Usage: scripts/flight.sh [--no-callgrind] [TARGET...]
+#   default targets: thumbv7em-none-eabihf (FPU, the flight target) thumbv7m-none-eabi
+#   thumbv6m-none-eabi (no FPU; both run on the Cortex-M7, a superset of their ISAs)
+# Needs: apt-get install rustc-web cargo-web rust-web-src lld qemu-system-arm
+#        gcc-arm-none-eabi (arm-none-eabi-size) valgrind; rustup's cargo first in PATH.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+
+callgrind=1
+targets=()
+for arg in "$@"; do
+    case $arg in
+        --no-callgrind) callgrind=0 ;;
+        -*) echo "flight: unknown option $arg" >&2; exit 2 ;;
+        *) targets+=("$arg") ;;
+    esac
+done
+[[ ${#targets[@]} -gt 0 ]] || targets=(thumbv7em-none-eabihf thumbv7m-none-eabi thumbv6m-none-eabi)
+
+cross_cargo="${CROSS_CARGO:-/usr/bin/cargo}"
+cross_rustc="${CROSS_RUSTC:-/usr/bin/rustc}"
+target_dir="${CARGO_TARGET_DIR:-$root/target}"
+out="$target_dir/flight"
+fw_target_dir="$target_dir/firmware"
+mkdir -p "$out"
+rm -f "$out"/*.log "$out"/*.size "$out"/*.rc "$out"/callgrind.txt
+
+die() { echo "flight: error: $*" >&2; exit 1; }
+for tool in "$cross_cargo" "$cross_rustc" qemu-system-arm arm-none-eabi-size ld.lld; do
+    command -v "$tool" >/dev/null || die "$tool not found (see the usage above for the packages)"
+done
+
+echo "::: flight: rustfmt and clippy (firmware crate, host side)"
+(cd firmware && cargo fmt --check && cargo clippy --release --quiet --lib --examples --bins \
+    --target-dir "$fw_target_dir/host" -- -D warnings)
+
+echo "::: flight: the embedded frames are what the renderer makes now"
+fresh="$(mktemp -d)"
+trap 'rm -rf "$fresh"' EXIT
+scripts/flight-frames.sh "$fresh/frames" >/dev/null
+diff -r "$fresh/frames" firmware/frames >/dev/null \
+    || die "firmware/frames differ from a fresh render: run scripts/flight-frames.sh and commit"
+
+echo "::: flight: host reference"
+cargo build --release --quiet --bin tirroi
+"$target_dir/release/tirroi" detect --method all --json firmware/frames/*.png >"$out/host-detect.jsonl"
+(cd firmware && cargo build --release --quiet --example host --example flight_report --target-dir "$fw_target_dir/host")
+host_bin="$fw_target_dir/host/release/examples/host"
+"$host_bin" >"$out/host-demo.log"
+
+for target in "${targets[@]}"; do
+    echo "::: flight: $target"
+    start=$SECONDS
+    (cd firmware && RUSTC="$cross_rustc" RUSTC_BOOTSTRAP=1 "$cross_cargo" build --release --quiet \
+        --target "$target" --target-dir "$fw_target_dir" \
+        -Zbuild-std=core -Zbuild-std-features=compiler-builtins-mem)
+    elf="$fw_target_dir/$target/release/tirroi-firmware"
+    arm-none-eabi-size -A "$elf" >"$out/$target.size"
+    rc=0
+    timeout 900 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -monitor none \
+        -serial none -semihosting-config enable=on,target=native \
+        -icount shift=0,align=off,sleep=off -kernel "$elf" >"$out/$target.log" || rc=$?
+    echo "$rc" >"$out/$target.rc"
+    echo "flight: $target: built and ran in $((SECONDS - start)) s (exit $rc)"
+done
+
+# The defmt variant (`--features defmt`): built for the flight target, so the feature
+# cannot rot; its output is binary (decode with `defmt-print -e ELF`).
+echo "::: flight: ${targets[0]} --features defmt (build only)"
+(cd firmware && RUSTC="$cross_rustc" RUSTC_BOOTSTRAP=1 "$cross_cargo" build --release --quiet \
+    --features defmt --target "${targets[0]}" --target-dir "$fw_target_dir/defmt" \
+    -Zbuild-std=core -Zbuild-std-features=compiler-builtins-mem)
+
+if command -v defmt-print >/dev/null; then
+    # Optional (cargo install defmt-print): run the defmt build and decode its frames.
+    defmt_elf="$fw_target_dir/defmt/${targets[0]}/release/tirroi-firmware"
+    timeout 900 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -monitor none \
+        -serial none -semihosting-config enable=on,target=native \
+        -icount shift=0,align=off,sleep=off -kernel "$defmt_elf" >"$out/defmt.bin"
+    defmt-print -e "$defmt_elf" <"$out/defmt.bin" >"$out/defmt.log"
+    grep -q '^done' "$out/defmt.log" || die "the defmt build did not finish (see $out/defmt.log)"
+    echo "flight: defmt build ran: $(stat -c %s "$out/defmt.bin") bytes of defmt frames, $(wc -l <"$out/defmt.log") lines decoded"
+fi
+
+if [[ $callgrind -eq 1 ]]; then
+    command -v valgrind >/dev/null || die "valgrind not found (apt-get install valgrind), or pass --no-callgrind"
+    echo "::: flight: callgrind (x86-64)"
+    frames=$(awk '$1 == "link" { sub("frame=", "", $2); print $2 }' "$out/host-demo.log")
+    methods=$(awk '$1 == "memory" { sub("method=", "", $2); print $2 }' "$out/host-demo.log")
+    for frame in $frames on-board-sensor; do
+        for method in $methods; do
+            cg="$out/callgrind.$frame.$method.out"
+            valgrind --tool=callgrind --toggle-collect='*Detectors*run*' \
+                --callgrind-out-file="$cg" "$host_bin" "$frame" "$method" >/dev/null 2>&1
+            echo "$frame $method $(awk '/^totals:/ { print $2 }' "$cg")" >>"$out/callgrind.txt"
+            rm -f "$cg"
+        done
+    done
+fi
+
+echo "::: flight: report"
+"$fw_target_dir/host/release/examples/flight_report" "$out" "${targets[@]}"
