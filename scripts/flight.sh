@@ -102,10 +102,13 @@ if [[ $callgrind -eq 1 ]]; then
     frames=$(awk '$1 == "link" { sub("frame=", "", $2); print $2 }' "$out/host-demo.log")
     methods=$(awk '$1 == "memory" { sub("method=", "", $2); print $2 }' "$out/host-demo.log")
     for frame in $frames on-board-sensor; do
-        for method in $methods; do
+        for method in $methods auto+prior; do
             cg="$out/callgrind.$frame.$method.out"
-            valgrind --tool=callgrind --toggle-collect='*Detectors*run*' \
-                --callgrind-out-file="$cg" "$host_bin" "$frame" "$method" >/dev/null 2>&1
+            toggle='*Detectors*run*'
+            [[ $method == *+prior ]] && toggle='*Detectors*track*'
+            valgrind --tool=callgrind --toggle-collect="$toggle" \
+                --callgrind-out-file="$cg" "$host_bin" "$frame" "$method" >"$out/callgrind.log" 2>&1 \
+                || die "callgrind of $frame $method failed: see $out/callgrind.log"
             echo "$frame $method $(awk '/^totals:/ { print $2 }' "$cg")" >>"$out/callgrind.txt"
             rm -f "$cg"
         done

@@ -182,6 +182,11 @@ fn run(dir: &Path, target_names: &[String]) -> Result<Vec<String>, String> {
         .filter(|l| l.kind == "memory")
         .map(|l| field(l, "method").to_string())
         .collect();
+    // The columns of the instruction tables: every method, then `auto` tracking.
+    let mut columns = methods.clone();
+    if host.iter().any(|l| field(l, "method") == "auto+prior") {
+        columns.push("auto+prior".to_string());
+    }
 
     // The host CLI's boxes for the embedded frames.
     let mut cli = BTreeMap::new();
@@ -286,8 +291,8 @@ fn run(dir: &Path, target_names: &[String]) -> Result<Vec<String>, String> {
         ram_budget,
         &mut failures,
     );
-    instruction_tables(&mut md, &targets, &frames, &methods, dir)?;
-    fpu_table(&mut md, &targets, &methods);
+    instruction_tables(&mut md, &targets, &frames, &columns, dir)?;
+    fpu_table(&mut md, &targets, &columns);
     let _ = writeln!(
         md,
         "\nBoxes: every detector's box and foreground count on every frame, on every \

@@ -5,11 +5,13 @@
 //! ```text
 //! cargo run --release --example host                       # the whole demo, one line per event
 //! cargo run --release --example host -- FRAME METHOD       # one detector on one frame, once
+//! cargo run --release --example host -- FRAME auto+prior   # auto, then auto tracking its box
 //! cargo run --release --example host -- on-board-sensor -  # only the sensor model
 //! ```
 //!
 //! The second form is what scripts/flight.sh runs under `valgrind --tool=callgrind
-//! --toggle-collect=...Detectors::run...` to count one call.
+//! --toggle-collect=...Detectors::run...` (`...Detectors::track...` for `auto+prior`)
+//! to count one call.
 
 use std::process::ExitCode;
 
@@ -79,7 +81,11 @@ fn one(ws: &mut Workspace<'_>, frame: &str, method: &str) -> Result<String, Stri
             *dn = u16::from_be_bytes([be[0], be[1]]);
         }
     }
-    let method = Method::from_name(method).ok_or_else(|| format!("no method `{method}`"))?;
+    let (name, tracking) = match method.strip_suffix("+prior") {
+        Some(name) => (name, true),
+        None => (method, false),
+    };
+    let method = Method::from_name(name).ok_or_else(|| format!("no method `{name}`"))?;
     let Workspace {
         frame: pixels,
         detectors,
@@ -87,6 +93,11 @@ fn one(ws: &mut Workspace<'_>, frame: &str, method: &str) -> Result<String, Stri
     } = ws;
     let view =
         Frame::new(&pixels[..], FRAME_WIDTH, FRAME_HEIGHT, BITS).map_err(|e| e.to_string())?;
-    let detection = detectors.run(method, &view).map_err(|e| e.to_string())?;
+    let mut detection = detectors.run(method, &view).map_err(|e| e.to_string())?;
+    if tracking {
+        // As the firmware: `auto` again with its own box as the prior.
+        let prior = detection.roi.ok_or("auto found nothing to track")?;
+        detection = detectors.track(prior, &view).map_err(|e| e.to_string())?;
+    }
     Ok(format!("{frame} {method} {:?}", detection.roi))
 }

@@ -5,7 +5,7 @@ use tirroi_core::roi::auto::{Auto, AutoScratch};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
-use tirroi_core::{DetectError, Detection, Detector, Frame, Method};
+use tirroi_core::{DetectError, Detection, Detector, Frame, Method, Roi};
 
 /// The methods the demo runs on every frame, in the core's order.
 pub const DEMO_METHODS: &[Method] = &Method::ALL;
@@ -61,6 +61,22 @@ impl Detectors {
             Method::Dog => Dog::default().detect(frame, &mut self.dog),
             Method::Auto => Auto::default().detect(frame, &mut self.auto),
         }
+    }
+}
+
+impl Detectors {
+    /// Runs `auto` in tracking mode: only a window around `prior` (the last frame's
+    /// box) is processed, the whole frame only when the target is lost there.
+    ///
+    /// Never inlined, for the same reason as [`Detectors::run`].
+    ///
+    /// # Errors
+    /// [`DetectError`] when the default parameters are refused (never).
+    #[inline(never)]
+    pub fn track(&mut self, prior: Roi, frame: &Frame<'_>) -> Result<Detection, DetectError> {
+        Auto::default()
+            .with_prior(Some(prior))
+            .detect(frame, &mut self.auto)
     }
 }
 

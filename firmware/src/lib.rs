@@ -7,7 +7,8 @@
 //! 1. every embedded frame ([`frames::FRAMES`], rendered by the host) is streamed in
 //!    through the SPI frame link of the core ([`tirroi_core::link`]) from a simulated
 //!    camera into the one frame buffer, with one corrupted row to show a retry;
-//! 2. every detector of the core runs on it ([`detectors::Detectors`]);
+//! 2. every detector of the core runs on it ([`detectors::Detectors`]), then `auto` in
+//!    tracking mode with its own box as the prior;
 //! 3. the camera model makes a frame on board ([`synth`]: band radiance table, DN map,
 //!    noise, row by row into the same buffer), and the detectors run on that too.
 //!
@@ -23,9 +24,9 @@ pub mod synth;
 
 use core::hint::black_box;
 
-use tirroi_core::Frame;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
 use tirroi_core::link::{FrameReader, SimulatedCamera};
+use tirroi_core::{Frame, Method};
 
 pub use detectors::{DEMO_METHODS, Detectors};
 pub use report::{Event, MeterReading};
@@ -177,6 +178,7 @@ fn detect_all<M: Meter>(
             return;
         }
     };
+    let mut prior = None;
     for &method in DEMO_METHODS {
         meter.start();
         let result = black_box(detectors.run(method, &frame));
@@ -185,6 +187,7 @@ fn detect_all<M: Meter>(
             Ok(detection) => emit(&Event::Detect {
                 frame: name,
                 method,
+                prior: None,
                 roi: detection.roi,
                 foreground_px: detection.foreground_px,
                 iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),
@@ -193,6 +196,30 @@ fn detect_all<M: Meter>(
             Err(_) => emit(&Event::Error {
                 frame: name,
                 what: "detector refused its parameters",
+            }),
+        }
+        if method == Method::Auto {
+            prior = result.ok().and_then(|d| d.roi);
+        }
+    }
+    // Tracking: `auto` again, given its own box as the last frame's.
+    if let Some(prior) = prior {
+        meter.start();
+        let result = black_box(detectors.track(prior, &frame));
+        let reading = meter.stop();
+        match result {
+            Ok(detection) => emit(&Event::Detect {
+                frame: name,
+                method: Method::Auto,
+                prior: Some(prior),
+                roi: detection.roi,
+                foreground_px: detection.foreground_px,
+                iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),
+                meter: reading,
+            }),
+            Err(_) => emit(&Event::Error {
+                frame: name,
+                what: "auto refused its prior",
             }),
         }
     }

@@ -48,6 +48,8 @@ pub enum Event {
         frame: &'static str,
         /// The detector.
         method: Method,
+        /// The tracking prior it was given (`auto` only), `None` for a full-frame search.
+        prior: Option<Roi>,
         /// Its box, `None` when nothing was foreground.
         roi: Option<Roi>,
         /// Foreground pixels of its mask.
@@ -130,12 +132,17 @@ impl fmt::Display for Event {
             Event::Detect {
                 frame,
                 method,
+                prior,
                 roi,
                 foreground_px,
                 iou,
                 meter,
             } => {
-                write!(f, "detect frame={frame} method={method} box=")?;
+                write!(f, "detect frame={frame} method={method}")?;
+                if prior.is_some() {
+                    f.write_str("+prior")?;
+                }
+                f.write_str(" box=")?;
                 match roi {
                     Some(r) => write!(f, "{},{},{},{}", r.x0, r.y0, r.x1, r.y1)?,
                     None => f.write_str("none")?,
@@ -211,6 +218,7 @@ impl defmt::Format for Event {
             Event::Detect {
                 frame,
                 method,
+                prior,
                 roi,
                 foreground_px,
                 iou,
@@ -219,9 +227,10 @@ impl defmt::Format for Event {
                 let b = roi.map(|r| [r.x0, r.y0, r.x1, r.y1]);
                 defmt::write!(
                     f,
-                    "detect frame={=str} method={=str} box={=?} fg={=u32} iou={=?} {}",
+                    "detect frame={=str} method={=str}{=str} box={=?} fg={=u32} iou={=?} {}",
                     frame,
                     method.name(),
+                    if prior.is_some() { "+prior" } else { "" },
                     b,
                     foreground_px,
                     iou,
