@@ -189,13 +189,6 @@ fn bad_parameters_are_errors() {
         ),
         (
             Auto {
-                fine_fraction_q8: 257,
-                ..Auto::default()
-            },
-            "fine_fraction_q8",
-        ),
-        (
-            Auto {
                 margin_px: 329,
                 ..Auto::default()
             },

@@ -40,7 +40,7 @@
 //! | wge | `drop_fraction` × `min_gradient` (Prewitt L1 DN) | {0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 0.995, 0.998} × {0, 48, 128, 256, 512, 1024, 2048, 4096, 8192} |
 //! | dog | `sigma0_px` × `levels` × `min_response_dn` (`sigma_ratio` 1.6) | {2, 4, 8} × {3, 5, 7} × {64, 128, 256, 512, 1024, 2048} (the 6 sets whose widest σ exceeds the core's bound skipped) |
 //!
-//! | auto | `coarse_k` × `fine_fraction_q8` (no box rule) | {8, 12, 16, 24} × {64, 86, 128} |
+//! | auto | `coarse_k` × `fine_k` (noise units; no box rule) | {6, 8, 10, 12, 16} × {6, 8, 12, 16} |
 //!
 //! That is 2 + 126 + 144 + 96 (+ 12 for auto) grid sets; the refinement adds some 20–150 trials per
 //! method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
@@ -302,8 +302,8 @@ impl Params {
                 p.sigma0_px, p.sigma_ratio, p.levels, p.min_response_dn
             ),
             Params::Auto(p) => format!(
-                "coarse_k={} fine_k={} fine_fraction_q8={} margin_px={}",
-                p.coarse_k, p.fine_k, p.fine_fraction_q8, p.margin_px
+                "coarse_k={} fine_k={} margin_px={}",
+                p.coarse_k, p.fine_k, p.margin_px
             ),
         }
     }
@@ -359,12 +359,6 @@ impl Params {
                 for fine_k in steps(&AUTO_K_LADDER, p.fine_k) {
                     out.push(Params::Auto(Auto { fine_k, ..p }));
                 }
-                for fine_fraction_q8 in steps(&AUTO_FRACTION_LADDER, p.fine_fraction_q8) {
-                    out.push(Params::Auto(Auto {
-                        fine_fraction_q8,
-                        ..p
-                    }));
-                }
             }
         }
         out.retain(Params::is_valid);
@@ -409,9 +403,7 @@ pub const RESPONSE_LADDER: [u32; 17] = [
 ];
 
 /// Refinement ladder of `auto`'s `coarse_k` and `fine_k` (noise units).
-pub const AUTO_K_LADDER: [u16; 9] = [4, 6, 8, 10, 12, 16, 20, 24, 32];
-/// Refinement ladder of `auto`'s `fine_fraction_q8` (1/256).
-pub const AUTO_FRACTION_LADDER: [u16; 7] = [32, 48, 64, 86, 110, 128, 160];
+pub const AUTO_K_LADDER: [u16; 11] = [3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32];
 
 /// The candidate grid of `method` (see the module documentation): every set of the
 /// grid with the largest-component rule, then every set with the all-foreground rule;
@@ -443,11 +435,11 @@ pub fn grid(method: Method) -> Vec<Params> {
             }
         }
         Method::Auto => {
-            for coarse_k in [8, 12, 16, 24] {
-                for fine_fraction_q8 in [64, 86, 128] {
+            for coarse_k in [6, 8, 10, 12, 16] {
+                for fine_k in [6, 8, 12, 16] {
                     base.push(Params::Auto(Auto {
                         coarse_k,
-                        fine_fraction_q8,
+                        fine_k,
                         ..Auto::default()
                     }));
                 }
@@ -1004,7 +996,7 @@ mod tests {
         }
         // The sizes the module documentation gives.
         let sizes = Method::ALL.map(|m| grid(m).len());
-        assert_eq!(sizes, [2, 126, 144, 96, 12]);
+        assert_eq!(sizes, [2, 126, 144, 96, 20]);
     }
 
     #[test]

@@ -4,28 +4,35 @@
 //!
 //! # Pipeline
 //!
-//! 1. **Plane and noise.** One pass over the frame (or the tracking window) makes the
-//!    4×4 block means ([`super::plane`], shared with DoG): an 82×62 plane. The pixel
-//!    noise σ (DN) is the median absolute difference of horizontal neighbours on every
-//!    fourth row (pairs both at 0 DN or both saturated are skipped: clipped noise says
-//!    nothing), divided by 0.954 (the median of |N(0, 2σ²)| is 0.954 σ).
-//! 2. **Coarse edges.** Prewitt L1 gradients of the plane (WGE's
-//!    [`prewitt_row`](super::wge::prewitt_row) on plane rows); a plane cell is an edge
-//!    cell when its gradient exceeds `coarse_k · σ / 4` (a 16-pixel mean has noise
-//!    σ/4). The Earth's smooth texture and the noise stay below it; the target's sharp
-//!    outline, and the Earth's limb, do not.
-//! 3. **Candidates.** Edge cells are labelled into 8-connected components (at most
-//!    [`MAX_COMPONENTS`]), each with its box, size, summed and largest gradient.
-//! 4. **Target decision.** Each component scores its summed gradient, divided by 8
-//!    for every side of the frame it touches: the limb (a long arc from border to
+//! 1. **Noise and scene.** Horizontal differences on 16 rows give two noise
+//!    estimates: first differences (which include the Earth's smooth texture) and
+//!    second differences (blind to smooth shading). Runs at 0 DN or saturated are
+//!    skipped (clipped noise says nothing). When most sampled pairs are both at 0 DN,
+//!    deep space fills the frame and the only texture is the target's own shading:
+//!    the second-difference σ is used, else the first.
+//! 2. **Step plane.** One pass over every other row of the frame (or the tracking
+//!    window): per 4×4 cell, the largest difference of a pixel and the pixel two to
+//!    its right or two below, in units of σ/4 (a `u8` plane of 82×62 cells). The
+//!    target's outline is a step; the Earth's texture is a ramp and the noise small.
+//! 3. **Candidates.** Cells with a step of at least `coarse_k · σ` are edge cells,
+//!    labelled into 8-connected components (at most [`MAX_COMPONENTS`]; a frame with
+//!    more is labelled again with a higher threshold), each with its cell box and
+//!    summed steps.
+//! 4. **Target decision.** Each component scores its summed steps, divided by 8 for
+//!    every side of the window it touches: the Earth's limb (an arc from border to
 //!    border) and Earth patches cut by the frame lose to a compact outline inside it.
-//! 5. **Refinement.** Full-resolution Prewitt gradients inside the winner's box (one
-//!    cell of margin), only at pixels whose cell neighbours the winner. Pixels with
-//!    gradient at least `max(fine_k · σ, gmax · fine_fraction)` (gmax: the winner's
-//!    largest coarse gradient, which for a step equals the full-resolution step
-//!    response) are edge pixels; a step between pixels `a | b` makes both edge
-//!    pixels, so the box of the edge pixels is one pixel too large on every side and
-//!    is shrunk by one.
+//! 5. **Refinement.** At full resolution inside the winner's cell box plus one cell,
+//!    only at pixels whose cell neighbours the winner: a step of at least
+//!    `fine_k · σ` between pixels `x − 1` and `x + 1`, the largest along its direction
+//!    (which drops the small step between a partly covered pixel and the background
+//!    beyond it), is a boundary before `x` when `x` resembles `x + 1`, else after it.
+//!    With labels of pixels at least half covered (our truth), that is the truth's
+//!    boundary for any contrast and polarity. The box spans the outermost boundaries.
+//! 6. **Saturated target** (detection mode, recognised by pixels at the top DN with
+//!    hardly any just below it, unlike a radiometry face at the top DN with noise):
+//!    pixels less than half covered saturate too, so the box is that of the
+//!    saturated pixels with outermost lines of at most 2 pixels trimmed (twice per
+//!    side at most), joined with the boundaries of unsaturated (cold) faces.
 //!
 //! # Tracking
 //!
@@ -36,8 +43,10 @@
 //!
 //! # Budgets
 //!
-//! No heap, no floating point in any loop over pixels or cells (only integer DN, sums
-//! and gradients), no panic on any frame; memory is [`SCRATCH_BYTES`].
+//! No heap; integer arithmetic only in every loop over pixels and cells (no floating
+//! point at all); no panic on any frame (`Frame` bounds every access; proptest and a
+//! fuzz target check it); memory [`SCRATCH_BYTES`] (≤ 32 KiB, checked at compile
+//! time).
 
 use super::plane::{BLOCK, Window};
 use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
@@ -61,13 +70,10 @@ pub struct Auto {
     /// Any box is accepted; it is cut to the frame, and an empty result means no prior.
     pub prior: Option<Roi>,
     /// Coarse edge threshold in units of the block-mean noise σ/4: 1..=1000.
-    /// Default 12.
+    /// Default 6.
     pub coarse_k: u16,
-    /// Full-resolution edge floor in units of the pixel noise σ: 1..=1000. Default 12.
+    /// Full-resolution edge floor in units of the pixel noise σ: 1..=1000. Default 8.
     pub fine_k: u16,
-    /// Full-resolution edge threshold as a fraction of the winner's largest gradient,
-    /// in 1/256: 0..=256. Default 86 (one third).
-    pub fine_fraction_q8: u16,
     /// Tracking window margin around the prior, in pixels: 0..=328. Default 16.
     pub margin_px: u16,
 }
@@ -76,9 +82,8 @@ impl Default for Auto {
     fn default() -> Self {
         Auto {
             prior: None,
-            coarse_k: 12,
-            fine_k: 12,
-            fine_fraction_q8: 86,
+            coarse_k: 6,
+            fine_k: 8,
             margin_px: 16,
         }
     }
@@ -143,8 +148,9 @@ const NO_COMPONENT: Component = Component {
 /// rows of the refinement.
 #[derive(Debug, Clone)]
 pub struct AutoWork {
-    /// Per cell of the window: the largest neighbour step in σ/4 (clamped to 255),
-    /// then the cell's component label (0: not an edge cell).
+    /// Per cell of the window: the largest step in σ/4 (clamped to 255).
+    step: [u8; GRID],
+    /// Per cell of the window: its component label (0: not an edge cell).
     label: [u8; GRID],
     parent: [u8; MAX_COMPONENTS + 1],
     comps: [Component; MAX_COMPONENTS + 1],
@@ -154,7 +160,9 @@ pub struct AutoWork {
     /// Saturated pixels per column and per row of the refinement window.
     col_sat: [u16; FRAME_WIDTH],
     row_sat: [u16; FRAME_HEIGHT],
-    hist: [u32; NOISE_BINS],
+    hist: [[u32; NOISE_BINS]; 2],
+    /// Cells of the refinement's gate in the current band of rows.
+    gate: [bool; GRID_WIDTH],
     /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
     /// of [`Detector::foreground`].
     mask: [bool; FRAME_WIDTH],
@@ -172,13 +180,15 @@ impl AutoScratch {
     pub const fn new() -> Self {
         Scratch {
             work: AutoWork {
+                step: [0; GRID],
                 label: [0; GRID],
                 parent: [0; MAX_COMPONENTS + 1],
                 comps: [NO_COMPONENT; MAX_COMPONENTS + 1],
                 steps: [0; FRAME_WIDTH],
                 col_sat: [0; FRAME_WIDTH],
                 row_sat: [0; FRAME_HEIGHT],
-                hist: [0; NOISE_BINS],
+                hist: [[0; NOISE_BINS]; 2],
+                gate: [false; GRID_WIDTH],
                 mask: [false; FRAME_WIDTH],
             },
             roi: RoiBuilder::new(),
@@ -225,48 +235,88 @@ fn bin_value(b: usize) -> u32 {
     lo + (1 << (l - 2)) / 2
 }
 
-/// Pixel noise σ in DN (≥ 1) of `win`, from horizontal neighbour differences on
-/// at most 16 evenly spaced rows (pairs both at 0 DN or both saturated are skipped).
-fn noise_sigma(
-    frame: &Frame<'_>,
-    win: Window,
-    hist: &mut [u32; NOISE_BINS],
-    buf: &mut [u16; FRAME_WIDTH],
-) -> u32 {
-    let max_dn = frame.max_dn();
-    hist.fill(0);
-    let mut n = 0u32;
-    let stride = (win.h / 16).max(1);
-    let mut y = win.y0 + stride / 2;
-    while y < win.y0 + win.h {
-        let row = win.row(frame, y);
-        let d = &mut buf[..row.len().saturating_sub(1)];
-        for ((o, &a), &b) in d.iter_mut().zip(row).zip(row.get(1..).unwrap_or(&[])) {
-            let (a, b) = (a.min(max_dn), b.min(max_dn));
-            let skip = (a | b) == 0 || (a & b) == max_dn;
-            *o = if skip { u16::MAX } else { a.abs_diff(b) };
-        }
-        for &v in d.iter() {
-            if v != u16::MAX {
-                hist[noise_bin(u32::from(v))] += 1;
-                n += 1;
-            }
-        }
-        y += stride;
-    }
+/// Median of the values counted in `hist` (`None` below 16 counts): the middle of
+/// its bin.
+fn hist_median(hist: &[u32; NOISE_BINS]) -> Option<u32> {
+    let n: u32 = hist.iter().sum();
     if n < 16 {
-        return 1;
+        return None;
     }
     let mut seen = 0;
-    let median = hist
-        .iter()
+    hist.iter()
         .position(|&c| {
             seen += c;
             2 * seen > n
         })
-        .map_or(1, bin_value);
-    // σ = median / 0.954.
-    ((median * 21 + 10) / 20).max(1)
+        .map(bin_value)
+}
+
+/// Pixel noise σ in DN (≥ 1) of `win`, from horizontal differences on at most 16
+/// evenly spaced rows (every other position; runs at 0 DN or saturated are skipped:
+/// clipped noise says nothing).
+///
+/// Two estimates: first differences `|b − a|` (σ = median / 0.954), which also see the
+/// Earth's smooth texture, so that texture stays below the edge thresholds; and second
+/// differences `|a − 2b + c|` (σ = median / 1.652), blind to smooth shading. The scene
+/// decides: when most sampled pairs are both at 0 DN (deep space fills the frame), the
+/// only texture is the target's own shading, which must not raise the thresholds, and
+/// the second-difference estimate is used; otherwise the first.
+fn noise_sigma(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [[u32; NOISE_BINS]; 2],
+    buf: &mut [u16; FRAME_WIDTH],
+) -> u32 {
+    let max_dn = frame.max_dn();
+    for h in hist.iter_mut() {
+        h.fill(0);
+    }
+    let (mut pairs, mut zero_pairs) = (0u32, 0u32);
+    let stride = (win.h / 16).max(1);
+    let mut y = win.y0 + stride / 2;
+    while y < win.y0 + win.h {
+        let row = win.row(frame, y);
+        let n = row.len().saturating_sub(2);
+        let d = &mut buf[..n];
+        for (((o, &a), &b), &c) in d
+            .iter_mut()
+            .zip(row)
+            .zip(row.get(1..).unwrap_or(&[]))
+            .zip(row.get(2..).unwrap_or(&[]))
+        {
+            let (a, b, c) = (a.min(max_dn), b.min(max_dn), c.min(max_dn));
+            let skip = (a | b | c) == 0 || (a & b & c) == max_dn;
+            let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
+            *o = if skip {
+                u16::MAX
+            } else {
+                d2.min(u32::from(u16::MAX - 1)) as u16
+            };
+        }
+        // Every other position is plenty for a median (about 2 600 on a full frame).
+        for (x, &v) in d.iter().enumerate().step_by(2) {
+            let (a, b) = (row[x].min(max_dn), row[x + 1].min(max_dn));
+            pairs += 1;
+            if (a | b) == 0 {
+                zero_pairs += 1;
+            } else if (a & b) != max_dn {
+                hist[0][noise_bin(u32::from(a.abs_diff(b)))] += 1;
+            }
+            if v != u16::MAX {
+                hist[1][noise_bin(u32::from(v))] += 1;
+            }
+        }
+        y += stride;
+    }
+    let first = hist_median(&hist[0]).map(|m| (m * 21 + 10) / 20);
+    let second = hist_median(&hist[1]).map(|m| (m * 20 + 16) / 33);
+    let space = 2 * zero_pairs > pairs;
+    let sigma = if space {
+        second.or(first)
+    } else {
+        first.or(second)
+    };
+    sigma.unwrap_or(1).max(1)
 }
 
 /// The outermost boundaries seen by the refinement, and the hull of their pixels.
@@ -295,6 +345,28 @@ impl Boundaries {
         self.hx = (self.hx.0.min(x), self.hx.1.max(x + 1));
         self.hy = (self.hy.0.min(y), self.hy.1.max(y + 1));
         self.count += 1;
+    }
+
+    /// True when a boundary before column `x` or `x + 1`, seen on row `y`, would
+    /// change nothing.
+    fn covers_x(&self, x: usize, y: usize) -> bool {
+        self.bx.0 <= x
+            && self.bx.1 > x
+            && self.hx.0 < x
+            && self.hx.1 > x
+            && self.hy.0 <= y
+            && self.hy.1 > y
+    }
+
+    /// True when a boundary before row `y` or `y + 1`, seen in column `x`, would
+    /// change nothing.
+    fn covers_y(&self, x: usize, y: usize) -> bool {
+        self.by.0 <= y
+            && self.by.1 > y
+            && self.hy.0 < y
+            && self.hy.1 > y
+            && self.hx.0 <= x
+            && self.hx.1 > x
     }
 
     /// A boundary before column `b`, seen on row `y`.
@@ -359,8 +431,10 @@ fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usize) -> Opti
 }
 
 /// The step plane of `win` into `plane` (`pw` cells per row): per cell, the largest
-/// absolute difference of a pixel and its right or lower neighbour, in units of σ/4,
-/// clamped to 255. `band` holds the per-pixel maxima of one band of rows.
+/// absolute difference of a pixel and the pixel two to its right or two below, on
+/// every other row (so every boundary between two pixels is spanned once per column
+/// and per pair of rows, at half the cost of neighbour differences on every row), in
+/// units of σ/4, clamped to 255. `band` holds the per-pixel maxima of one band of rows.
 fn step_plane(
     frame: &Frame<'_>,
     win: Window,
@@ -375,61 +449,70 @@ fn step_plane(
     // q = cm · 4/σ, as a 16.16 reciprocal.
     let inv = (4u64 << 16) / u64::from(sigma.max(1));
     let c = |v: u16| v.min(max_dn);
+    let last = win.y0 + win.h - 1;
     for (cy, plane_row) in plane.chunks_exact_mut(pw).enumerate() {
         band.fill(0);
         let y_end = (win.y0 + (cy + 1) * BLOCK).min(win.y0 + win.h);
-        for y in win.y0 + cy * BLOCK..y_end {
+        for y in (win.y0 + cy * BLOCK..y_end).step_by(2) {
             let row = win.row(frame, y);
-            let below = if y + 1 < frame.height() {
-                win.row(frame, y + 1)
-            } else {
-                row
-            };
+            // Two rows down, or the last row of the window (a step there still shows).
+            let below = win.row(frame, (y + 2).min(last).max(y));
             if row.len() != n || below.len() != n {
                 continue;
             }
-            for (((m, &v), &r), &b) in band.iter_mut().zip(row).zip(&row[1..]).zip(below) {
+            let span = 2.min(n - 1);
+            for (((m, &v), &r), &b) in band.iter_mut().zip(row).zip(&row[span..]).zip(below) {
                 let (v, r, b) = (c(v), c(r), c(b));
                 *m = (*m).max(v.abs_diff(r)).max(v.abs_diff(b));
             }
-            band[n - 1] = band[n - 1].max(c(row[n - 1]).abs_diff(c(below[n - 1])));
+            for x in n.saturating_sub(span)..n {
+                band[x] = band[x].max(c(row[x]).abs_diff(c(below[x])));
+            }
         }
-        for (q, chunk) in plane_row.iter_mut().zip(band.chunks(BLOCK)) {
-            let cm = chunk.iter().fold(0u16, |m, &v| m.max(v));
+        let mut cells = band.chunks_exact(BLOCK);
+        for (q, chunk) in plane_row.iter_mut().zip(&mut cells) {
+            let cm = chunk[0].max(chunk[1]).max(chunk[2]).max(chunk[3]);
+            *q = ((u64::from(cm) * inv) >> 16).min(255) as u8;
+        }
+        // A partial cell at the right edge.
+        if let (Some(q), false) = (plane_row.get_mut(n / BLOCK), cells.remainder().is_empty()) {
+            let cm = cells.remainder().iter().fold(0u16, |m, &v| m.max(v));
             *q = ((u64::from(cm) * inv) >> 16).min(255) as u8;
         }
     }
 }
 
-/// Labels the cells of `plane` whose step is at least `threshold` into 8-connected
-/// components (in place, raster order, union-find with statistics merged on union);
-/// other cells become 0. Returns one past the last label used.
+/// Labels the cells whose `step` is at least `threshold` into 8-connected components
+/// in `plane` (raster order, union-find with statistics merged on union); other cells
+/// get 0. Returns one past the last label used, or `None` when some edge cell found no
+/// free label (it is left unlabelled).
 fn label_edges(
+    step: &[u8],
     plane: &mut [u8],
     pw: usize,
-    ph: usize,
     threshold: u8,
     parent: &mut [u8; MAX_COMPONENTS + 1],
     comps: &mut [Component; MAX_COMPONENTS + 1],
-) -> usize {
+) -> Option<usize> {
     let mut next = 1usize;
-    for cy in 0..ph {
-        for cx in 0..pw {
-            let i = cy * pw + cx;
-            let q = plane[i];
-            plane[i] = 0;
+    let mut overflow = false;
+    for (cy, steps) in step.chunks_exact(pw).enumerate() {
+        let (before, rest) = plane.split_at_mut(cy * pw);
+        let cur = &mut rest[..pw];
+        cur.fill(0);
+        if steps.iter().all(|&q| q < threshold) {
+            continue;
+        }
+        let prev = before.get(before.len().saturating_sub(pw)..).unwrap_or(&[]);
+        let up = |cx: usize| prev.get(cx).copied().unwrap_or(0);
+        for (cx, &q) in steps.iter().enumerate() {
             if q < threshold {
                 continue;
             }
+            let left = if cx > 0 { cur[cx - 1] } else { 0 };
+            let up_left = if cx > 0 { up(cx - 1) } else { 0 };
             let mut l = 0u8;
-            let neighbours = [
-                (cx > 0).then(|| i - 1),
-                (cx > 0 && cy > 0).then(|| i - pw - 1),
-                (cy > 0).then(|| i - pw),
-                (cx + 1 < pw && cy > 0).then(|| i - pw + 1),
-            ];
-            for n in neighbours.into_iter().flatten() {
-                let m = plane[n];
+            for m in [left, up_left, up(cx), up(cx + 1)] {
                 if m == 0 {
                     continue;
                 }
@@ -446,6 +529,7 @@ fn label_edges(
             }
             if l == 0 {
                 if next > MAX_COMPONENTS {
+                    overflow = true;
                     continue;
                 }
                 l = next as u8;
@@ -453,11 +537,11 @@ fn label_edges(
                 comps[next] = NO_COMPONENT;
                 next += 1;
             }
-            plane[i] = l;
+            cur[cx] = l;
             comps[usize::from(l)].add(cx as u8, cy as u8, u32::from(q));
         }
     }
-    next
+    (!overflow).then_some(next)
 }
 
 /// Root of component `l`, halving the path.
@@ -481,6 +565,7 @@ impl Auto {
         let (pw, ph) = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
         let sigma = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
         let AutoWork {
+            step,
             label,
             parent,
             comps,
@@ -488,15 +573,28 @@ impl Auto {
             col_sat,
             row_sat,
             mask,
+            gate,
             ..
         } = work;
+        let gate_cells = &mut gate[..pw];
         let label = &mut label[..pw * ph];
-        step_plane(frame, win, sigma, pw, steps, label);
+        let step = &mut step[..pw * ph];
+        step_plane(frame, win, sigma, pw, steps, step);
 
         // Edge cells (step ≥ coarse_k·σ), labelled in raster order (8-connected,
-        // union-find on u8 labels, statistics merged on union).
-        let threshold = (u32::from(self.coarse_k) * 4).min(255) as u8;
-        let next = label_edges(label, pw, ph, threshold, parent, comps);
+        // union-find on u8 labels, statistics merged on union). A frame with more
+        // components than labels (noise, texture) is labelled again with a threshold
+        // half as high again, up to four times.
+        let mut threshold = (u32::from(self.coarse_k) * 4).min(255) as u8;
+        let mut next = None;
+        for _ in 0..4 {
+            next = label_edges(step, label, pw, threshold, parent, comps);
+            if next.is_some() || threshold == u8::MAX {
+                break;
+            }
+            threshold = threshold.saturating_add(threshold / 2);
+        }
+        let next = next.unwrap_or(MAX_COMPONENTS + 1);
         // The target decision: summed steps, / 8 per window side touched.
         let (pw8, ph8) = (pw as u8, ph as u8);
         let sides = |c: &Component| {
@@ -546,9 +644,13 @@ impl Auto {
             }
         }
         let tau = (u32::from(self.fine_k) * sigma).min(u32::from(u16::MAX)) as u16;
+        // Beside a saturated target the frame is nearly noise-free and the boundaries
+        // that matter are of cold, unsaturated faces: twice the threshold.
+        let tau_unsat = tau.saturating_mul(2);
         let near_sat = max_dn.saturating_sub((4 * sigma).min(u32::from(u16::MAX)) as u16);
         let mut all = Boundaries::NONE;
         let mut unsat = Boundaries::NONE;
+        let mut edge_px = 0u32;
         let (mut sat_px, mut near_px) = (0u32, 0u32);
         let col_sat = &mut col_sat[rx0..rx1];
         let row_sat = &mut row_sat[ry0..ry1];
@@ -561,30 +663,45 @@ impl Auto {
             let cy = (y - win.y0) / BLOCK;
             if cy != gate_row {
                 gate_row = cy;
+                // A cell is in the gate when it or a neighbour is the winner's.
                 let (ya, yb) = (cy.saturating_sub(1), (cy + 2).min(ph));
+                let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
+                gate_cells.fill(false);
+                for gy in ya..yb {
+                    let labels = &label[gy * pw..(gy + 1) * pw];
+                    let lo = ca.saturating_sub(1);
+                    for (cx, &l) in labels.iter().enumerate().take((cb + 1).min(pw)).skip(lo) {
+                        if l == root {
+                            let (a, b) = (cx.saturating_sub(1), (cx + 2).min(pw));
+                            gate_cells[a..b].fill(true);
+                        }
+                    }
+                }
                 for (x, g) in (rx0..rx1).zip(gate_px.iter_mut()) {
-                    let cx = (x - win.x0) / BLOCK;
-                    let (xa, xb) = (cx.saturating_sub(1), (cx + 2).min(pw));
-                    *g = (ya..yb).any(|gy| (xa..xb).any(|gx| label[gy * pw + gx] == root));
+                    *g = gate_cells[(x - win.x0) / BLOCK];
                 }
             }
             let Some(row) = frame.row(y) else { continue };
             let row = &row[..fw];
-            // Saturation counts (gated).
-            let mut near = 0u32;
-            for ((&v, cs), &g) in row[rx0..rx1]
-                .iter()
-                .zip(col_sat.iter_mut())
-                .zip(gate_px.iter())
-            {
-                let v = v.min(max_dn);
-                let sat = u16::from(g && v >= max_dn);
-                *cs += sat;
-                *rs += sat;
-                near += u32::from(g && v >= near_sat && v < max_dn);
+            // Saturation counts (gated), for rows that come near saturation.
+            if row[rx0..rx1].iter().any(|&v| v.min(max_dn) >= near_sat) {
+                let (mut sat_row, mut near) = (0u32, 0u32);
+                for ((&v, cs), &g) in row[rx0..rx1]
+                    .iter()
+                    .zip(col_sat.iter_mut())
+                    .zip(gate_px.iter())
+                {
+                    let v = v.min(max_dn);
+                    let g = u16::from(g);
+                    let sat = g & u16::from(v >= max_dn);
+                    *cs += sat;
+                    sat_row += u32::from(sat);
+                    near += u32::from(g & u16::from(v >= near_sat) & u16::from(v < max_dn));
+                }
+                *rs = sat_row as u16;
+                sat_px += sat_row;
+                near_px += near;
             }
-            sat_px += u32::from(*rs);
-            near_px += near;
             // Step flags: bit 0 horizontal, bit 1 vertical.
             flags.fill(0);
             let (xa, xb) = (rx0.max(1), rx1.min(fw - 1));
@@ -603,55 +720,66 @@ impl Auto {
                     *f |= u16::from(a.min(max_dn).abs_diff(b.min(max_dn)) >= tau) << 1;
                 }
             }
-            for ((x, &f), &g) in (rx0..rx1).zip(flags.iter()).zip(gate_px.iter()) {
-                if f == 0 || !g {
+            let (above2, below2) = (
+                y.checked_sub(2).and_then(|u| frame.row(u)),
+                frame.row(y + 2),
+            );
+            for (i, (f16, g16)) in flags.chunks(16).zip(gate_px.chunks(16)).enumerate() {
+                if f16.iter().all(|&f| f == 0) {
                     continue;
                 }
-                let c = row[x].min(max_dn);
-                // Steps that are not the largest along their direction (the small
-                // step between a partly covered pixel and the background beyond it,
-                // noise beside an edge) are not boundaries.
-                if f & 1 != 0 {
-                    let at = |i: usize| row.get(i).map(|&v| v.min(max_dn));
-                    let (l, r) = (row[x - 1].min(max_dn), row[x + 1].min(max_dn));
-                    let step = l.abs_diff(r);
-                    let before = x.checked_sub(2).and_then(at).map_or(0, |v| v.abs_diff(c));
-                    let after = at(x + 2).map_or(0, |v| v.abs_diff(c));
-                    if step >= before && step >= after {
-                        let b = if c.abs_diff(l) >= c.abs_diff(r) {
-                            x
-                        } else {
-                            x + 1
-                        };
-                        all.add_x(b, y);
-                        if l.max(r) < max_dn {
-                            unsat.add_x(b, y);
+                for (j, (&f, &g)) in f16.iter().zip(g16).enumerate() {
+                    if f == 0 || !g {
+                        continue;
+                    }
+                    edge_px += 1;
+                    let x = rx0 + 16 * i + j;
+                    let c = row[x].min(max_dn);
+                    // Only a boundary beyond those already seen can move the box.
+                    let h = f & 1 != 0 && !(all.covers_x(x, y) && unsat.covers_x(x, y));
+                    let v = f & 2 != 0 && !(all.covers_y(x, y) && unsat.covers_y(x, y));
+                    // Steps that are not the largest along their direction (the small
+                    // step between a partly covered pixel and the background beyond it,
+                    // noise beside an edge) are not boundaries.
+                    if h {
+                        let at = |i: usize| row.get(i).map(|&v| v.min(max_dn));
+                        let (l, r) = (row[x - 1].min(max_dn), row[x + 1].min(max_dn));
+                        let step = l.abs_diff(r);
+                        let before = x.checked_sub(2).and_then(at).map_or(0, |v| v.abs_diff(c));
+                        let after = at(x + 2).map_or(0, |v| v.abs_diff(c));
+                        if step >= before && step >= after {
+                            let b = if c.abs_diff(l) >= c.abs_diff(r) {
+                                x
+                            } else {
+                                x + 1
+                            };
+                            all.add_x(b, y);
+                            if l.max(r) < max_dn && step >= tau_unsat {
+                                unsat.add_x(b, y);
+                            }
                         }
                     }
-                }
-                if let (true, Some(a), Some(d)) = (f & 2 != 0, above, below) {
-                    let at = |yy: Option<usize>| {
-                        yy.and_then(|yy| frame.row(yy)).map(|r| r[x].min(max_dn))
-                    };
-                    let (u, d) = (a[x].min(max_dn), d[x].min(max_dn));
-                    let step = u.abs_diff(d);
-                    let before = at(y.checked_sub(2)).map_or(0, |v| v.abs_diff(c));
-                    let after = at(Some(y + 2)).map_or(0, |v| v.abs_diff(c));
-                    if step >= before && step >= after {
-                        let b = if c.abs_diff(u) >= c.abs_diff(d) {
-                            y
-                        } else {
-                            y + 1
-                        };
-                        all.add_y(x, b);
-                        if u.max(d) < max_dn {
-                            unsat.add_y(x, b);
+                    if let (true, Some(a), Some(d)) = (v, above, below) {
+                        let at = |r: Option<&[u16]>| r.map(|r| r[x].min(max_dn));
+                        let (u, d) = (a[x].min(max_dn), d[x].min(max_dn));
+                        let step = u.abs_diff(d);
+                        let before = at(above2).map_or(0, |v| v.abs_diff(c));
+                        let after = at(below2).map_or(0, |v| v.abs_diff(c));
+                        if step >= before && step >= after {
+                            let b = if c.abs_diff(u) >= c.abs_diff(d) {
+                                y
+                            } else {
+                                y + 1
+                            };
+                            all.add_y(x, b);
+                            if u.max(d) < max_dn && step >= tau_unsat {
+                                unsat.add_y(x, b);
+                            }
                         }
                     }
                 }
             }
         }
-        let edge_px = all.count;
         // A saturated target (detection mode) is flat at max_dn: hardly any pixel just
         // below it, unlike a radiometry face at max_dn with noise.
         let saturated = sat_px >= 4 && 8 * near_px < sat_px;
@@ -726,12 +854,6 @@ impl Detector for Auto {
             return Err(DetectError::InvalidParameter {
                 name: "fine_k",
                 expected: "1..=1000 (units of the pixel noise)",
-            });
-        }
-        if self.fine_fraction_q8 > 256 {
-            return Err(DetectError::InvalidParameter {
-                name: "fine_fraction_q8",
-                expected: "0..=256 (1/256 of the largest gradient)",
             });
         }
         if usize::from(self.margin_px) > FRAME_WIDTH {
