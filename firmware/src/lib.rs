@@ -183,23 +183,9 @@ fn detect_all<M: Meter>(
         meter.start();
         let result = black_box(detectors.run(method, &frame));
         let reading = meter.stop();
-        match result {
-            Ok(detection) => emit(&Event::Detect {
-                frame: name,
-                method,
-                prior: None,
-                roi: detection.roi,
-                foreground_px: detection.foreground_px,
-                iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),
-                meter: reading,
-            }),
-            Err(_) => emit(&Event::Error {
-                frame: name,
-                what: "detector refused its parameters",
-            }),
-        }
+        let found = report_detection(emit, name, method, None, truth, result, reading);
         if method == Method::Auto {
-            prior = result.ok().and_then(|d| d.roi);
+            prior = found;
         }
     }
     // Tracking: `auto` again, given its own box as the last frame's.
@@ -207,20 +193,47 @@ fn detect_all<M: Meter>(
         meter.start();
         let result = black_box(detectors.track(prior, &frame));
         let reading = meter.stop();
-        match result {
-            Ok(detection) => emit(&Event::Detect {
-                frame: name,
-                method: Method::Auto,
-                prior: Some(prior),
+        report_detection(
+            emit,
+            name,
+            Method::Auto,
+            Some(prior),
+            truth,
+            result,
+            reading,
+        );
+    }
+}
+
+/// Emits the event of one detector call; returns its box.
+fn report_detection(
+    emit: &mut dyn FnMut(&Event),
+    frame: &'static str,
+    method: Method,
+    prior: Option<tirroi_core::Roi>,
+    truth: Option<tirroi_core::Roi>,
+    result: Result<tirroi_core::Detection, tirroi_core::DetectError>,
+    meter: MeterReading,
+) -> Option<tirroi_core::Roi> {
+    match result {
+        Ok(detection) => {
+            emit(&Event::Detect {
+                frame,
+                method,
+                prior,
                 roi: detection.roi,
                 foreground_px: detection.foreground_px,
                 iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),
-                meter: reading,
-            }),
-            Err(_) => emit(&Event::Error {
-                frame: name,
-                what: "auto refused its prior",
-            }),
+                meter,
+            });
+            detection.roi
+        }
+        Err(_) => {
+            emit(&Event::Error {
+                frame,
+                what: "detector refused its parameters",
+            });
+            None
         }
     }
 }
