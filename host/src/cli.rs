@@ -117,6 +117,12 @@ pub enum Command {
         /// Write scores.csv, summary.csv and summary.json here.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Tracking prior for auto: off (search every frame whole); jitter (the truth
+        /// box moved by up to 4 px and each side by up to 10 %, as a tracker would hand
+        /// it over); sequence (frames in file-name order, each frame's prior is auto's
+        /// box on the previous one; one thread).
+        #[arg(long, default_value = "off", value_parser = parse_track)]
+        track: eval::Track,
     },
     /// Reproduce the paper's results: render (or reuse) the datasets, score every
     /// detector, print Tables 6, 7 and 8 beside the paper's, and write the figures.
@@ -274,6 +280,17 @@ fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
     }
 }
 
+fn parse_track(s: &str) -> Result<eval::Track, String> {
+    match s {
+        "off" => Ok(eval::Track::Off),
+        "jitter" => Ok(eval::Track::Jitter),
+        "sequence" => Ok(eval::Track::Sequence),
+        _ => Err(format!(
+            "unknown tracking mode `{s}`; expected off, jitter or sequence"
+        )),
+    }
+}
+
 /// One method or all of them.
 #[derive(Debug, Clone)]
 pub struct MethodChoice(pub Vec<Method>);
@@ -333,12 +350,14 @@ pub fn main() -> ExitCode {
             box_rule,
             bits,
             out,
+            track,
         } => {
             let options = eval::EvalOptions {
                 methods: method.0,
                 repeat: repeat as usize,
                 box_rule: Some(box_rule),
                 bits,
+                track,
             };
             exit_code(run_eval(
                 &images,

@@ -168,6 +168,46 @@ pub struct EvalOptions {
     pub box_rule: Option<BoxRule>,
     /// Bit depth of the frames (None: from the file, 14 for 16-bit files that fit).
     pub bits: Option<u8>,
+    /// Where `auto` gets its tracking prior (the other methods have none).
+    pub track: Track,
+}
+
+/// Where `auto` gets its tracking prior during an evaluation ([`EvalOptions::track`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Track {
+    /// No prior: every frame is searched whole.
+    #[default]
+    Off,
+    /// The truth box as a tracker would hand it over: moved by up to ±4 px in x and y
+    /// and each side grown or shrunk by up to 10 % of the box size, from a hash of the
+    /// file name ([`jittered_prior`]), so the same frame always gets the same prior.
+    Jitter,
+    /// The frames, in file-name order, are one sequence: each frame's prior is `auto`'s
+    /// box on the previous frame (none on the first frame and after a miss). Frames
+    /// are scored one after the other on one thread.
+    Sequence,
+}
+
+/// The prior of [`Track::Jitter`]: `truth` moved by `dx, dy ∈ [−4, 4]` px and each
+/// side moved out or in by up to 10 % of the box's width or height (rounded), all from
+/// the FNV-1a hash of `file`; cut to the frame by the detector.
+pub fn jittered_prior(truth: Roi, file: &str) -> Roi {
+    let mut h = crate::tune::fnv1a64(file.as_bytes());
+    let mut next = |n: i32| {
+        h ^= h >> 29;
+        h = h.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        let v = ((h >> 33) % (2 * n as u64 + 1)) as i32;
+        v - n
+    };
+    let (w, hh) = (i32::from(truth.width()), i32::from(truth.height()));
+    let (dx, dy) = (next(4), next(4));
+    let side = |size: i32, r: i32| (size * r + 50) / 100;
+    let x0 = i32::from(truth.x0) + dx - side(w, next(10));
+    let x1 = i32::from(truth.x1) + dx + side(w, next(10));
+    let y0 = i32::from(truth.y0) + dy - side(hh, next(10));
+    let y1 = i32::from(truth.y1) + dy + side(hh, next(10));
+    let c = |v: i32| v.clamp(0, i32::from(u16::MAX)) as u16;
+    Roi::new(c(x0), c(y0), c(x1), c(y1))
 }
 
 /// Scores every `(row, method)`; `make_bank` gives each worker thread its detectors
@@ -182,6 +222,9 @@ pub fn score(
     make_bank: &(dyn Fn() -> DetectorBank + Sync),
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<FrameScore>, EvalError> {
+    if options.track == Track::Sequence {
+        return score_sequence(images, rows, options, make_bank, progress);
+    }
     let per_row: Vec<Result<Vec<FrameScore>, EvalError>> = rows
         .par_iter()
         .map_init(
@@ -200,6 +243,9 @@ pub fn score(
                     .view()
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
                 let mut out = Vec::with_capacity(options.methods.len());
+                if options.track == Track::Jitter {
+                    bank.auto.prior = Some(jittered_prior(row.roi, &row.file));
+                }
                 for &m in &options.methods {
                     let (d, time_us) = bank
                         .detect_timed(m, &view, options.repeat)
@@ -223,6 +269,53 @@ pub fn score(
     let mut scores = Vec::new();
     for r in per_row {
         scores.extend(r?);
+    }
+    Ok(scores)
+}
+
+/// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, `auto`'s
+/// prior from its box on the previous frame.
+fn score_sequence(
+    images: &Path,
+    rows: &[TruthRow],
+    options: &EvalOptions,
+    make_bank: &(dyn Fn() -> DetectorBank + Sync),
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<FrameScore>, EvalError> {
+    let mut bank = make_bank();
+    if let Some(rule) = options.box_rule {
+        bank.set_box_rule(rule);
+    }
+    let mut order: Vec<&TruthRow> = rows.iter().collect();
+    order.sort_by(|a, b| a.file.cmp(&b.file));
+    let mut previous = None;
+    let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
+    for row in order {
+        let path: PathBuf = images.join(&row.file);
+        let frame = read_frame(&path, options.bits).map_err(|e| EvalError(e.to_string()))?;
+        let view = frame
+            .view()
+            .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
+        bank.auto.prior = previous;
+        for &m in &options.methods {
+            let (d, time_us) = bank
+                .detect_timed(m, &view, options.repeat)
+                .map_err(|e| EvalError(format!("{}: {m}: {e}", path.display())))?;
+            if m == Method::Auto {
+                previous = d.roi;
+            }
+            scores.push(FrameScore {
+                file: row.file.clone(),
+                method: m.name(),
+                bbox: d.roi.map(|r| r.to_array()),
+                truth: row.roi.to_array(),
+                iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
+                time_us,
+                groups: row.groups.clone(),
+                range_m: row.range_m,
+            });
+        }
+        progress();
     }
     Ok(scores)
 }

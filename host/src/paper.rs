@@ -149,6 +149,7 @@ fn score(
         repeat: options.repeat,
         box_rule: None,
         bits: None,
+        track: eval::Track::Off,
     };
     let scores = eval::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
         bar.inc(1)

@@ -602,6 +602,7 @@ pub fn evaluate_together(
         repeat: 1,
         box_rule: None,
         bits,
+        track: eval::Track::Off,
     };
     let make_bank = || {
         let mut bank = DetectorBank::default();

@@ -12,12 +12,14 @@
 //!    the second-difference σ is used, else the first.
 //! 2. **Step plane.** One pass over every other row of the frame (or the tracking
 //!    window): per 4×4 cell, the largest difference of a pixel and the pixel two to
-//!    its right or two below, in units of σ/4 (a `u8` plane of 82×62 cells). The
-//!    target's outline is a step; the Earth's texture is a ramp and the noise small.
+//!    its right or two below, in units of σ/4, as an 8-bit logarithmic code (16 codes
+//!    per octave; a plane of 82×62 cells). The target's outline is a step; the
+//!    Earth's texture is a ramp and the noise small.
 //! 3. **Candidates.** Cells with a step of at least `coarse_k · σ` are edge cells,
 //!    labelled into 8-connected components (at most [`MAX_COMPONENTS`]; a frame with
-//!    more is labelled again with a higher threshold), each with its cell box and
-//!    summed steps.
+//!    more is labelled again with a threshold half as high again), each with its cell
+//!    box and summed steps (linear, so a saturated target's outline outweighs a wide
+//!    patch of the Earth's texture).
 //! 4. **Target decision.** Each component scores its summed steps, divided by 8 for
 //!    every side of the window it touches: the Earth's limb (an arc from border to
 //!    border) and Earth patches cut by the frame lose to a compact outline inside it.
@@ -148,7 +150,7 @@ const NO_COMPONENT: Component = Component {
 /// rows of the refinement.
 #[derive(Debug, Clone)]
 pub struct AutoWork {
-    /// Per cell of the window: the largest step in σ/4 (clamped to 255).
+    /// Per cell of the window: the largest step in σ/4, as a [`step_code`].
     step: [u8; GRID],
     /// Per cell of the window: its component label (0: not an edge cell).
     label: [u8; GRID],
@@ -434,7 +436,7 @@ fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usize) -> Opti
 /// absolute difference of a pixel and the pixel two to its right or two below, on
 /// every other row (so every boundary between two pixels is spanned once per column
 /// and per pair of rows, at half the cost of neighbour differences on every row), in
-/// units of σ/4, clamped to 255. `band` holds the per-pixel maxima of one band of rows.
+/// units of σ/4, as a [`step_code`]. `band` holds the per-pixel maxima of one band of rows.
 fn step_plane(
     frame: &Frame<'_>,
     win: Window,
@@ -472,12 +474,12 @@ fn step_plane(
         let mut cells = band.chunks_exact(BLOCK);
         for (q, chunk) in plane_row.iter_mut().zip(&mut cells) {
             let cm = chunk[0].max(chunk[1]).max(chunk[2]).max(chunk[3]);
-            *q = ((u64::from(cm) * inv) >> 16).min(255) as u8;
+            *q = step_code(((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32);
         }
         // A partial cell at the right edge.
         if let (Some(q), false) = (plane_row.get_mut(n / BLOCK), cells.remainder().is_empty()) {
             let cm = cells.remainder().iter().fold(0u16, |m, &v| m.max(v));
-            *q = ((u64::from(cm) * inv) >> 16).min(255) as u8;
+            *q = step_code(((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32);
         }
     }
 }
@@ -538,10 +540,33 @@ fn label_edges(
                 next += 1;
             }
             cur[cx] = l;
-            comps[usize::from(l)].add(cx as u8, cy as u8, u32::from(q));
+            comps[usize::from(l)].add(cx as u8, cy as u8, step_value(q));
         }
     }
     (!overflow).then_some(next)
+}
+
+/// The 8-bit code of a step of `v` (units of σ/4): 16 codes per octave,
+/// `16·⌊log2 v⌋ + ` the next 4 bits of `v`, 0 for 0, at most 255 (`v` ≥ 2^15.9).
+/// Integer only; [`step_value`] inverts it to within 1/16 of an octave.
+fn step_code(v: u32) -> u8 {
+    if v == 0 {
+        return 0;
+    }
+    let l = 31 - v.leading_zeros();
+    let frac = if l >= 4 {
+        (v >> (l - 4)) & 15
+    } else {
+        (v << (4 - l)) & 15
+    };
+    (16 * l + frac).min(255) as u8
+}
+
+/// The step (units of σ/4) a [`step_code`] stands for: the bottom of its sixteenth
+/// of an octave.
+fn step_value(code: u8) -> u32 {
+    let (l, frac) = (u32::from(code) / 16, u32::from(code) % 16);
+    ((16 + frac) << l) >> 4
 }
 
 /// Root of component `l`, halving the path.
@@ -585,14 +610,15 @@ impl Auto {
         // union-find on u8 labels, statistics merged on union). A frame with more
         // components than labels (noise, texture) is labelled again with a threshold
         // half as high again, up to four times.
-        let mut threshold = (u32::from(self.coarse_k) * 4).min(255) as u8;
+        let mut threshold = step_code(u32::from(self.coarse_k) * 4);
         let mut next = None;
         for _ in 0..4 {
             next = label_edges(step, label, pw, threshold, parent, comps);
             if next.is_some() || threshold == u8::MAX {
                 break;
             }
-            threshold = threshold.saturating_add(threshold / 2);
+            // Half as high again: 16·log2(1.5) ≈ 9 codes.
+            threshold = threshold.saturating_add(9);
         }
         let next = next.unwrap_or(MAX_COMPONENTS + 1);
         // The target decision: summed steps, / 8 per window side touched.
@@ -702,22 +728,37 @@ impl Auto {
                 sat_px += sat_row;
                 near_px += near;
             }
-            // Step flags: bit 0 horizontal, bit 1 vertical.
-            flags.fill(0);
-            let (xa, xb) = (rx0.max(1), rx1.min(fw - 1));
-            if xa < xb {
-                let (l, r) = (&row[xa - 1..xb - 1], &row[xa + 1..xb + 1]);
-                for ((f, &a), &b) in flags[xa - rx0..xb - rx0].iter_mut().zip(l).zip(r) {
-                    *f = u16::from(a.min(max_dn).abs_diff(b.min(max_dn)) >= tau);
-                }
-            }
+            // Step flags: bit 0 horizontal, bit 1 vertical (one pass where both exist).
             let (above, below) = (
                 y.checked_sub(1).and_then(|u| frame.row(u)),
                 frame.row(y + 1),
             );
-            if let (Some(a), Some(b)) = (above, below) {
-                for ((f, &a), &b) in flags.iter_mut().zip(&a[rx0..rx1]).zip(&b[rx0..rx1]) {
-                    *f |= u16::from(a.min(max_dn).abs_diff(b.min(max_dn)) >= tau) << 1;
+            let (xa, xb) = (rx0.max(1), rx1.min(fw - 1));
+            let c = |v: u16| v.min(max_dn);
+            match (above, below) {
+                (Some(a), Some(b)) if xa < xb => {
+                    for ((((f, &l), &r), &u), &d) in flags[xa - rx0..xb - rx0]
+                        .iter_mut()
+                        .zip(&row[xa - 1..xb - 1])
+                        .zip(&row[xa + 1..xb + 1])
+                        .zip(&a[xa..xb])
+                        .zip(&b[xa..xb])
+                    {
+                        *f = u16::from(c(l).abs_diff(c(r)) >= tau)
+                            | (u16::from(c(u).abs_diff(c(d)) >= tau) << 1);
+                    }
+                    for x in (rx0..xa).chain(xb..rx1) {
+                        flags[x - rx0] = u16::from(c(a[x]).abs_diff(c(b[x])) >= tau) << 1;
+                    }
+                }
+                _ => {
+                    flags.fill(0);
+                    if xa < xb {
+                        let (l, r) = (&row[xa - 1..xb - 1], &row[xa + 1..xb + 1]);
+                        for ((f, &a), &b) in flags[xa - rx0..xb - rx0].iter_mut().zip(l).zip(r) {
+                            *f = u16::from(c(a).abs_diff(c(b)) >= tau);
+                        }
+                    }
                 }
             }
             let (above2, below2) = (
@@ -725,7 +766,7 @@ impl Auto {
                 frame.row(y + 2),
             );
             for (i, (f16, g16)) in flags.chunks(16).zip(gate_px.chunks(16)).enumerate() {
-                if f16.iter().all(|&f| f == 0) {
+                if f16.iter().fold(0, |a, &f| a | f) == 0 {
                     continue;
                 }
                 for (j, (&f, &g)) in f16.iter().zip(g16).enumerate() {
@@ -906,6 +947,25 @@ impl Detector for Auto {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn step_codes_are_monotone_and_invert() {
+        let mut last = 0;
+        for v in 0..70_000u32 {
+            let c = step_code(v);
+            assert!(c >= last, "{v}");
+            last = c;
+            if (1..60_000).contains(&v) {
+                let back = step_value(c);
+                assert!(
+                    back <= v && 17 * u64::from(back) >= 16 * u64::from(v) - 16,
+                    "{v} {c} {back}"
+                );
+            }
+        }
+        assert_eq!(step_code(1), 0);
+        assert_eq!(step_code(24), 16 * 4 + 8);
+    }
 
     #[test]
     fn noise_bins_round_trip() {
