@@ -40,8 +40,9 @@
 //!
 //! With [`Auto::prior`] set, the pipeline runs on the prior grown by
 //! `margin_px + max(width, height) / 8` on every side. If nothing is found there, or
-//! the winner touches the window's border (the target left the window or grew out of
-//! it), the full frame is processed instead.
+//! the box found misses the prior or reaches the window's border (the target left the
+//! window, grew out of it, or the prior was wrong), the full frame is processed
+//! instead.
 //!
 //! # Budgets
 //!
@@ -71,12 +72,15 @@ pub struct Auto {
     /// Tracking prior: the last frame's box, or `None` to search the whole frame.
     /// Any box is accepted; it is cut to the frame, and an empty result means no prior.
     pub prior: Option<Roi>,
-    /// Coarse edge threshold in units of the block-mean noise σ/4: 1..=1000.
-    /// Default 6.
+    /// Coarse edge threshold: a cell is an edge cell when its largest step reaches
+    /// `coarse_k · σ` (σ: the pixel noise, DN): 1..=1000. Default 6.
     pub coarse_k: u16,
-    /// Full-resolution edge floor in units of the pixel noise σ: 1..=1000. Default 8.
+    /// Full-resolution boundary threshold: a step over two pixels counts when it
+    /// reaches `fine_k · σ` (twice that beside a saturated target): 1..=1000. Default 8.
     pub fine_k: u16,
-    /// Tracking window margin around the prior, in pixels: 0..=328. Default 16.
+    /// Tracking window margin around the prior, in pixels: 0..=328. Default 16 (plus
+    /// `max(width, height) / 8`: room for a move of several pixels and a 10 % change of
+    /// size per frame).
     pub margin_px: u16,
 }
 
@@ -163,8 +167,6 @@ pub struct AutoWork {
     col_sat: [u16; FRAME_WIDTH],
     row_sat: [u16; FRAME_HEIGHT],
     hist: [[u32; NOISE_BINS]; 2],
-    /// Cells of the refinement's gate in the current band of rows.
-    gate: [bool; GRID_WIDTH],
     /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
     /// of [`Detector::foreground`].
     mask: [bool; FRAME_WIDTH],
@@ -190,7 +192,6 @@ impl AutoScratch {
                 col_sat: [0; FRAME_WIDTH],
                 row_sat: [0; FRAME_HEIGHT],
                 hist: [[0; NOISE_BINS]; 2],
-                gate: [false; GRID_WIDTH],
                 mask: [false; FRAME_WIDTH],
             },
             roi: RoiBuilder::new(),
@@ -212,8 +213,6 @@ struct Found {
     threshold: u32,
     /// Full-resolution edge pixels inside the gate.
     edge_px: u32,
-    /// The winner touches the window's border.
-    at_window_edge: bool,
 }
 
 /// Noise histogram bin of an absolute difference: exact below 16, then 4 per octave.
@@ -347,28 +346,6 @@ impl Boundaries {
         self.hx = (self.hx.0.min(x), self.hx.1.max(x + 1));
         self.hy = (self.hy.0.min(y), self.hy.1.max(y + 1));
         self.count += 1;
-    }
-
-    /// True when a boundary before column `x` or `x + 1`, seen on row `y`, would
-    /// change nothing.
-    fn covers_x(&self, x: usize, y: usize) -> bool {
-        self.bx.0 <= x
-            && self.bx.1 > x
-            && self.hx.0 < x
-            && self.hx.1 > x
-            && self.hy.0 <= y
-            && self.hy.1 > y
-    }
-
-    /// True when a boundary before row `y` or `y + 1`, seen in column `x`, would
-    /// change nothing.
-    fn covers_y(&self, x: usize, y: usize) -> bool {
-        self.by.0 <= y
-            && self.by.1 > y
-            && self.hy.0 < y
-            && self.hy.1 > y
-            && self.hx.0 <= x
-            && self.hx.1 > x
     }
 
     /// A boundary before column `b`, seen on row `y`.
@@ -598,10 +575,8 @@ impl Auto {
             col_sat,
             row_sat,
             mask,
-            gate,
             ..
         } = work;
-        let gate_cells = &mut gate[..pw];
         let label = &mut label[..pw * ph];
         let step = &mut step[..pw * ph];
         step_plane(frame, win, sigma, pw, steps, step);
@@ -653,188 +628,200 @@ impl Auto {
         let ry0 = win.y0 + cell_px(c.y0.saturating_sub(1));
         let rx1 = (win.x0 + cell_px(c.x1.saturating_add(1))).min(win.x0 + win.w);
         let ry1 = (win.y0 + cell_px(c.y1.saturating_add(1))).min(win.y0 + win.h);
-        // Labels to roots around the winner, so the gate is one comparison per cell.
-        let (gx0, gx1) = (
-            usize::from(c.x0.saturating_sub(2)),
-            (usize::from(c.x1) + 2).min(pw),
-        );
-        let (gy0, gy1) = (
-            usize::from(c.y0.saturating_sub(2)),
-            (usize::from(c.y1) + 2).min(ph),
-        );
-        for cy in gy0..gy1 {
-            for l in &mut label[cy * pw + gx0..cy * pw + gx1] {
+        // The gate: cells that are the winner's or touch one of its cells (in `step`,
+        // free after labelling), over the refinement window's cells.
+        let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
+        let (ra, rb) = ((ry0 - win.y0) / BLOCK, (ry1 - 1 - win.y0) / BLOCK + 1);
+        // Labels to roots around the winner first, so the gate is comparisons only.
+        for cy in ra.saturating_sub(1)..(rb + 1).min(ph) {
+            for l in &mut label[cy * pw + ca.saturating_sub(1)..cy * pw + (cb + 1).min(pw)] {
                 if *l != 0 {
                     *l = find(parent, *l);
                 }
             }
         }
+        let gate = &mut step[..];
+        for cy in ra..rb {
+            for cx in ca..cb {
+                let (ya, yb) = (cy.saturating_sub(1), (cy + 2).min(ph));
+                let (xa, xb) = (cx.saturating_sub(1), (cx + 2).min(pw));
+                let hit = (ya..yb).any(|gy| label[gy * pw + xa..gy * pw + xb].contains(&root));
+                gate[cy * pw + cx] = u8::from(hit);
+            }
+        }
+        let gate = &*gate;
+        let gated =
+            |x: usize, y: usize| gate[(y - win.y0) / BLOCK * pw + (x - win.x0) / BLOCK] != 0;
         let tau = (u32::from(self.fine_k) * sigma).min(u32::from(u16::MAX)) as u16;
         // Beside a saturated target the frame is nearly noise-free and the boundaries
         // that matter are of cold, unsaturated faces: twice the threshold.
         let tau_unsat = tau.saturating_mul(2);
         let near_sat = max_dn.saturating_sub((4 * sigma).min(u32::from(u16::MAX)) as u16);
-        let mut all = Boundaries::NONE;
-        let mut unsat = Boundaries::NONE;
-        let mut edge_px = 0u32;
+
+        // Saturation counts (gated), on rows that come near saturation.
         let (mut sat_px, mut near_px) = (0u32, 0u32);
         let col_sat = &mut col_sat[rx0..rx1];
         let row_sat = &mut row_sat[ry0..ry1];
         col_sat.fill(0);
         row_sat.fill(0);
-        let flags = &mut steps[rx0..rx1];
         let gate_px = &mut mask[rx0..rx1];
-        let mut gate_row = usize::MAX;
         for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
-            let cy = (y - win.y0) / BLOCK;
-            if cy != gate_row {
-                gate_row = cy;
-                // A cell is in the gate when it or a neighbour is the winner's.
-                let (ya, yb) = (cy.saturating_sub(1), (cy + 2).min(ph));
-                let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
-                gate_cells.fill(false);
-                for gy in ya..yb {
-                    let labels = &label[gy * pw..(gy + 1) * pw];
-                    let lo = ca.saturating_sub(1);
-                    for (cx, &l) in labels.iter().enumerate().take((cb + 1).min(pw)).skip(lo) {
-                        if l == root {
-                            let (a, b) = (cx.saturating_sub(1), (cx + 2).min(pw));
-                            gate_cells[a..b].fill(true);
-                        }
-                    }
-                }
-                for (x, g) in (rx0..rx1).zip(gate_px.iter_mut()) {
-                    *g = gate_cells[(x - win.x0) / BLOCK];
-                }
-            }
             let Some(row) = frame.row(y) else { continue };
-            let row = &row[..fw];
-            // Saturation counts (gated), for rows that come near saturation.
-            if row[rx0..rx1].iter().any(|&v| v.min(max_dn) >= near_sat) {
-                let (mut sat_row, mut near) = (0u32, 0u32);
-                for ((&v, cs), &g) in row[rx0..rx1]
-                    .iter()
-                    .zip(col_sat.iter_mut())
-                    .zip(gate_px.iter())
-                {
-                    let v = v.min(max_dn);
-                    let g = u16::from(g);
-                    let sat = g & u16::from(v >= max_dn);
-                    *cs += sat;
-                    sat_row += u32::from(sat);
-                    near += u32::from(g & u16::from(v >= near_sat) & u16::from(v < max_dn));
-                }
-                *rs = sat_row as u16;
-                sat_px += sat_row;
-                near_px += near;
+            let row = &row[rx0..rx1];
+            if !row.iter().any(|&v| v.min(max_dn) >= near_sat) {
+                continue;
             }
-            // Step flags: bit 0 horizontal, bit 1 vertical (one pass where both exist).
-            let (above, below) = (
-                y.checked_sub(1).and_then(|u| frame.row(u)),
-                frame.row(y + 1),
-            );
-            let (xa, xb) = (rx0.max(1), rx1.min(fw - 1));
-            let c = |v: u16| v.min(max_dn);
-            match (above, below) {
-                (Some(a), Some(b)) if xa < xb => {
-                    for ((((f, &l), &r), &u), &d) in flags[xa - rx0..xb - rx0]
-                        .iter_mut()
-                        .zip(&row[xa - 1..xb - 1])
-                        .zip(&row[xa + 1..xb + 1])
-                        .zip(&a[xa..xb])
-                        .zip(&b[xa..xb])
-                    {
-                        *f = u16::from(c(l).abs_diff(c(r)) >= tau)
-                            | (u16::from(c(u).abs_diff(c(d)) >= tau) << 1);
-                    }
-                    for x in (rx0..xa).chain(xb..rx1) {
-                        flags[x - rx0] = u16::from(c(a[x]).abs_diff(c(b[x])) >= tau) << 1;
-                    }
-                }
-                _ => {
-                    flags.fill(0);
-                    if xa < xb {
-                        let (l, r) = (&row[xa - 1..xb - 1], &row[xa + 1..xb + 1]);
-                        for ((f, &a), &b) in flags[xa - rx0..xb - rx0].iter_mut().zip(l).zip(r) {
-                            *f = u16::from(c(a).abs_diff(c(b)) >= tau);
-                        }
-                    }
-                }
+            for (x, g) in (rx0..rx1).zip(gate_px.iter_mut()) {
+                *g = gated(x, y);
             }
-            let (above2, below2) = (
-                y.checked_sub(2).and_then(|u| frame.row(u)),
-                frame.row(y + 2),
-            );
-            for (i, (f16, g16)) in flags.chunks(16).zip(gate_px.chunks(16)).enumerate() {
-                if f16.iter().fold(0, |a, &f| a | f) == 0 {
-                    continue;
+            let (mut sat_row, mut near) = (0u32, 0u32);
+            for ((&v, cs), &g) in row.iter().zip(col_sat.iter_mut()).zip(gate_px.iter()) {
+                let v = v.min(max_dn);
+                let g = u16::from(g);
+                let sat = g & u16::from(v >= max_dn);
+                *cs += sat;
+                sat_row += u32::from(sat);
+                near += u32::from(g & u16::from(v >= near_sat) & u16::from(v < max_dn));
+            }
+            *rs = sat_row as u16;
+            sat_px += sat_row;
+            near_px += near;
+        }
+        // A saturated target (detection mode) is flat at max_dn: hardly any pixel just
+        // below it, unlike a radiometry face at max_dn with noise. Then the boundaries
+        // sought are those of unsaturated faces (twice the threshold).
+        let saturated = sat_px >= 4 && 8 * near_px < sat_px;
+        let (tau, keep_saturated) = if saturated {
+            (tau_unsat, false)
+        } else {
+            (tau, true)
+        };
+        let clamp = |v: u16| v.min(max_dn);
+        let rows = |y: usize| frame.row(y).map(|r| &r[..fw]);
+        // A boundary at pixel x of row y from a horizontal step: `Some(b)` (a boundary
+        // before column b) when |v(x+1) − v(x−1)| ≥ τ, no neighbouring step along the
+        // row is larger, and the pixels are gated (and unsaturated, unless kept).
+        let h_boundary = |row: &[u16], x: usize, y: usize| -> Option<usize> {
+            if x == 0 || x + 1 >= fw {
+                return None;
+            }
+            let (l, v, r) = (clamp(row[x - 1]), clamp(row[x]), clamp(row[x + 1]));
+            let step = l.abs_diff(r);
+            if step < tau || !(keep_saturated || l.max(r) < max_dn) || !gated(x, y) {
+                return None;
+            }
+            let before = x.checked_sub(2).map_or(0, |i| clamp(row[i]).abs_diff(v));
+            let after = row.get(x + 2).map_or(0, |&w| clamp(w).abs_diff(v));
+            (step >= before && step >= after).then_some(if v.abs_diff(l) >= v.abs_diff(r) {
+                x
+            } else {
+                x + 1
+            })
+        };
+        // The same down a column: a boundary before row b.
+        let v_boundary = |x: usize, y: usize| -> Option<usize> {
+            let (Some(a), Some(v), Some(d)) =
+                (y.checked_sub(1).and_then(rows), rows(y), rows(y + 1))
+            else {
+                return None;
+            };
+            let (u, v, d) = (clamp(a[x]), clamp(v[x]), clamp(d[x]));
+            let step = u.abs_diff(d);
+            if step < tau || !(keep_saturated || u.max(d) < max_dn) || !gated(x, y) {
+                return None;
+            }
+            let before = y
+                .checked_sub(2)
+                .and_then(rows)
+                .map_or(0, |r| clamp(r[x]).abs_diff(v));
+            let after = rows(y + 2).map_or(0, |r| clamp(r[x]).abs_diff(v));
+            (step >= before && step >= after).then_some(if v.abs_diff(u) >= v.abs_diff(d) {
+                y
+            } else {
+                y + 1
+            })
+        };
+        // Outside in: the box needs only the outermost boundaries, so each row is
+        // scanned from the left until its first boundary (or until it cannot beat the
+        // leftmost one so far) and from the right alike; rows are scanned from the top
+        // until one holds a boundary from a vertical step, and from the bottom alike.
+        // A saturated target's box comes from its saturated pixels; boundaries of cold
+        // faces matter only beyond it.
+        let sat = if saturated {
+            saturated_box(col_sat, rx0, row_sat, ry0)
+        } else {
+            None
+        };
+        let (lim_x0, lim_y0, lim_x1, lim_y1) = sat.map_or((rx1, ry1, rx0, ry0), |s| {
+            (
+                usize::from(s.x0),
+                usize::from(s.y0),
+                usize::from(s.x1),
+                usize::from(s.y1),
+            )
+        });
+        let mut found = Boundaries::NONE;
+        // One row per cell band first (cheap bounds for the rest), then every row.
+        let sparse = (ry0 + BLOCK / 2..ry1).step_by(BLOCK);
+        for y in sparse.chain(ry0..ry1) {
+            let Some(row) = rows(y) else { continue };
+            let quick = |x: usize| {
+                x > 0 && x + 1 < fw && clamp(row[x - 1]).abs_diff(clamp(row[x + 1])) >= tau
+            };
+            let mut x = rx0;
+            while x < lim_x0.min(rx1) && x <= found.bx.0 {
+                if let Some(b) = quick(x).then(|| h_boundary(row, x, y)).flatten() {
+                    found.add_x(b, y);
+                    break;
                 }
-                for (j, (&f, &g)) in f16.iter().zip(g16).enumerate() {
-                    if f == 0 || !g {
-                        continue;
-                    }
-                    edge_px += 1;
-                    let x = rx0 + 16 * i + j;
-                    let c = row[x].min(max_dn);
-                    // Only a boundary beyond those already seen can move the box.
-                    let h = f & 1 != 0 && !(all.covers_x(x, y) && unsat.covers_x(x, y));
-                    let v = f & 2 != 0 && !(all.covers_y(x, y) && unsat.covers_y(x, y));
-                    // Steps that are not the largest along their direction (the small
-                    // step between a partly covered pixel and the background beyond it,
-                    // noise beside an edge) are not boundaries.
-                    if h {
-                        let at = |i: usize| row.get(i).map(|&v| v.min(max_dn));
-                        let (l, r) = (row[x - 1].min(max_dn), row[x + 1].min(max_dn));
-                        let step = l.abs_diff(r);
-                        let before = x.checked_sub(2).and_then(at).map_or(0, |v| v.abs_diff(c));
-                        let after = at(x + 2).map_or(0, |v| v.abs_diff(c));
-                        if step >= before && step >= after {
-                            let b = if c.abs_diff(l) >= c.abs_diff(r) {
-                                x
-                            } else {
-                                x + 1
-                            };
-                            all.add_x(b, y);
-                            if l.max(r) < max_dn && step >= tau_unsat {
-                                unsat.add_x(b, y);
-                            }
-                        }
-                    }
-                    if let (true, Some(a), Some(d)) = (v, above, below) {
-                        let at = |r: Option<&[u16]>| r.map(|r| r[x].min(max_dn));
-                        let (u, d) = (a[x].min(max_dn), d[x].min(max_dn));
-                        let step = u.abs_diff(d);
-                        let before = at(above2).map_or(0, |v| v.abs_diff(c));
-                        let after = at(below2).map_or(0, |v| v.abs_diff(c));
-                        if step >= before && step >= after {
-                            let b = if c.abs_diff(u) >= c.abs_diff(d) {
-                                y
-                            } else {
-                                y + 1
-                            };
-                            all.add_y(x, b);
-                            if u.max(d) < max_dn && step >= tau_unsat {
-                                unsat.add_y(x, b);
-                            }
-                        }
-                    }
+                x += 1;
+            }
+            let mut x = rx1;
+            while x > rx0.max(lim_x1) && x >= found.bx.1 {
+                x -= 1;
+                if let Some(b) = quick(x).then(|| h_boundary(row, x, y)).flatten() {
+                    found.add_x(b, y);
+                    break;
                 }
             }
         }
-        // A saturated target (detection mode) is flat at max_dn: hardly any pixel just
-        // below it, unlike a radiometry face at max_dn with noise.
-        let saturated = sat_px >= 4 && 8 * near_px < sat_px;
-        let roi = if saturated {
-            let sat = saturated_box(col_sat, rx0, row_sat, ry0);
-            sat.map(|s| unsat.roi().map_or(s, |u| s.hull(&u)))
-        } else {
-            all.roi()
+        let vertical = |y: usize, found: &mut Boundaries| {
+            let (Some(a), Some(d)) = (y.checked_sub(1).and_then(rows), rows(y + 1)) else {
+                return false;
+            };
+            let mut hit = false;
+            for x in rx0..rx1 {
+                // The cheap test first: most pixels hold no step.
+                if clamp(a[x]).abs_diff(clamp(d[x])) < tau {
+                    continue;
+                }
+                if let Some(b) = v_boundary(x, y) {
+                    found.add_y(x, b);
+                    hit = true;
+                }
+            }
+            hit
+        };
+        for y in ry0..ry1.min(lim_y0) {
+            if vertical(y, &mut found) {
+                break;
+            }
+        }
+        for y in (ry0.max(lim_y1)..ry1).rev() {
+            if y < found.by.1 || vertical(y, &mut found) {
+                break;
+            }
+        }
+        let edge_px = found.count;
+        let roi = match sat {
+            Some(s) => Some(found.roi().map_or(s, |u| s.hull(&u))),
+            None if saturated => None,
+            None => found.roi(),
         };
         roi.map(|roi| Found {
             roi: Some(roi),
             threshold: u32::from(self.coarse_k) * sigma,
             edge_px,
-            at_window_edge: sides(&c) > 0,
         })
     }
 
@@ -854,7 +841,20 @@ impl Auto {
                 );
                 if let Some(win) = win.filter(|w| !w.is_full(frame)) {
                     if let Some(f) = self.locate(frame, work, win) {
-                        if !f.at_window_edge {
+                        // Still the tracked target: the box overlaps the prior and is
+                        // not cut by the window (a side on the window's border is one
+                        // the frame's border, or the target left the window).
+                        let (fw, fh) = (frame.width(), frame.height());
+                        let kept = f.roi.is_some_and(|r| {
+                            let (x0, y0) = (usize::from(r.x0), usize::from(r.y0));
+                            let (x1, y1) = (usize::from(r.x1), usize::from(r.y1));
+                            !r.intersection(&p).is_empty()
+                                && (x0 > win.x0 || win.x0 == 0)
+                                && (y0 > win.y0 || win.y0 == 0)
+                                && (x1 < win.x0 + win.w || x1 == fw)
+                                && (y1 < win.y0 + win.h || y1 == fh)
+                        });
+                        if kept {
                             return detection(f);
                         }
                     }
