@@ -76,19 +76,25 @@ fn partial_pixels_go_to_the_side_they_resemble() {
     assert_eq!(detect(Auto::default(), &px), Some(Roi::new(39, 29, 80, 60)));
 }
 
-/// A dark target (500 DN) in front of a smooth, noisy Earth that fills the frame
-/// below a straight limb at row 200 (deep space above it).
-fn earth_scene(x: usize, y: usize) -> u16 {
-    let target = (150..190).contains(&x) && (60..110).contains(&y)
-        || (190..230).contains(&x) && (75..95).contains(&y);
-    let v = if target {
-        500
-    } else if y >= 30 {
+/// The smooth, noisy Earth below a straight limb at row 30 (deep space above it).
+fn earth_only(x: usize, y: usize) -> u16 {
+    let v = if y >= 30 {
         4000 + 8 * x as i32 + 6 * y as i32 + ((x as f64 / 9.0).sin() * 300.0) as i32
     } else {
         40
     };
     (v + noise(x, y, 20)).clamp(0, 16383) as u16
+}
+
+/// A dark target (500 DN) in front of [`earth_only`].
+fn earth_scene(x: usize, y: usize) -> u16 {
+    let target = (150..190).contains(&x) && (60..110).contains(&y)
+        || (190..230).contains(&x) && (75..95).contains(&y);
+    if target {
+        (500 + noise(x, y, 20)) as u16
+    } else {
+        earth_only(x, y)
+    }
 }
 
 #[test]
@@ -152,6 +158,45 @@ fn wrong_prior_falls_back_to_the_full_frame() {
             full,
             "{prior:?}"
         );
+    }
+}
+
+/// Frame `i` of a sequence: a dark box moving 3 px right and 1 px down per frame and
+/// growing, over the textured Earth of `earth_scene`; frame 12 jumps elsewhere.
+fn sequence_frame(i: usize) -> (Vec<u16>, Roi) {
+    let (x0, y0) = if i == 12 {
+        (40, 150)
+    } else {
+        (60 + 3 * i, 50 + i)
+    };
+    let (w, h) = (30 + i, 20 + i / 2);
+    let truth = Roi::new(x0 as u16, y0 as u16, (x0 + w) as u16, (y0 + h) as u16);
+    let px = frame_of(|x, y| {
+        if truth.contains(x as u16, y as u16) {
+            (600 + noise(x, y, 20)) as u16
+        } else {
+            earth_only(x, y)
+        }
+    });
+    (px, truth)
+}
+
+#[test]
+fn sequence_tracks_with_its_own_boxes_and_reacquires_after_a_jump() {
+    let mut s = Box::<AutoScratch>::default();
+    let mut prior = None;
+    for i in 0..20 {
+        let (px, truth) = sequence_frame(i);
+        let frame = Frame::reference(&px).unwrap();
+        let tracked = Auto::default()
+            .with_prior(prior)
+            .detect(&frame, &mut s)
+            .unwrap()
+            .roi;
+        let full = Auto::default().detect(&frame, &mut s).unwrap().roi;
+        assert_eq!(tracked, full, "frame {i}");
+        assert_eq!(tracked, Some(truth), "frame {i}");
+        prior = tracked;
     }
 }
 
