@@ -297,7 +297,9 @@ pub fn auto_table(scores: &PaperScores) -> String {
     let mut s = String::from(
         "`auto` against the best of the paper's four per row (test split; times: median core time per frame)\n\n| table | row | frames | auto mean IoU | best of four | its mean IoU | auto median time [ms] | its median time [ms] | adaptive median time [ms] |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    let rows: [(&str, &[FrameScore], &str, &[&str], &str); 5] = [
+    // (table, its scores, group column, group values, range band)
+    type Row<'a> = (&'a str, &'a [FrameScore], &'a str, &'a [&'a str], &'a str);
+    let rows: [Row<'_>; 5] = [
         (
             "6",
             &scores.radiometry,
