@@ -30,6 +30,9 @@
 //!    beyond it), is a boundary before `x` when `x` resembles `x + 1`, else after it.
 //!    With labels of pixels at least half covered (our truth), that is the truth's
 //!    boundary for any contrast and polarity. The box spans the outermost boundaries.
+//!    In clean deep space (sunlit frames: 0 DN nearly everywhere, clipped noise a
+//!    sparse sprinkle), a step from 0 DN below `fine_k · σ` also counts when the pixel
+//!    beyond it and its four neighbours are above 0: a faint (cold) face.
 //! 6. **Saturated target** (detection mode, recognised by pixels at the top DN with
 //!    hardly any just below it, unlike a radiometry face at the top DN with noise):
 //!    pixels less than half covered saturate too, so the box is that of the
@@ -267,12 +270,12 @@ fn noise_sigma(
     win: Window,
     hist: &mut [[u32; NOISE_BINS]; 2],
     buf: &mut [u16; FRAME_WIDTH],
-) -> u32 {
+) -> (u32, bool) {
     let max_dn = frame.max_dn();
     for h in hist.iter_mut() {
         h.fill(0);
     }
-    let (mut pairs, mut zero_pairs) = (0u32, 0u32);
+    let (mut pairs, mut zero_pairs, mut one_zero) = (0u32, 0u32, 0u32);
     let stride = (win.h / 16).max(1);
     let mut y = win.y0 + stride / 2;
     while y < win.y0 + win.h {
@@ -298,6 +301,7 @@ fn noise_sigma(
         for (x, &v) in d.iter().enumerate().step_by(2) {
             let (a, b) = (row[x].min(max_dn), row[x + 1].min(max_dn));
             pairs += 1;
+            one_zero += u32::from(a.min(b) == 0 && a.max(b) > 0);
             if (a | b) == 0 {
                 zero_pairs += 1;
             } else if (a & b) != max_dn {
@@ -317,7 +321,11 @@ fn noise_sigma(
     } else {
         first.or(second)
     };
-    sigma.unwrap_or(1).max(1)
+    // Clean deep space: at 0 DN nearly everywhere (sunlit frames), with at most a
+    // sparse sprinkle of clipped-noise pixels (noise clipped at 0 around a level at 0
+    // makes two pairs touching 0 with one side above it for every pair both at 0).
+    let clean = space && zero_pairs >= 4 * one_zero;
+    (sigma.unwrap_or(1).max(1), clean)
 }
 
 /// The outermost boundaries seen by the refinement, and the hull of their pixels.
@@ -565,7 +573,7 @@ impl Auto {
         let max_dn = frame.max_dn();
         let fw = frame.width();
         let (pw, ph) = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
-        let sigma = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
+        let (sigma, clean) = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
         let AutoWork {
             step,
             label,
@@ -701,13 +709,37 @@ impl Auto {
         // A boundary at pixel x of row y from a horizontal step: `Some(b)` (a boundary
         // before column b) when |v(x+1) − v(x−1)| ≥ τ, no neighbouring step along the
         // row is larger, and the pixels are gated (and unsaturated, unless kept).
+        // In clean deep space a faint face (a few hundred DN, below τ) still shows as a
+        // solid patch above 0 DN, where the clipped noise is a sparse sprinkle: a step
+        // from 0 DN counts when the pixel beyond it and its four neighbours are above 0.
+        let solid = |x: usize, y: usize| {
+            let at = |x: usize, y: usize| rows(y).and_then(|r| r.get(x)).is_some_and(|&v| v > 0);
+            x > 0
+                && y > 0
+                && at(x, y)
+                && at(x - 1, y)
+                && at(x + 1, y)
+                && at(x, y - 1)
+                && at(x, y + 1)
+        };
+        let faint = |a: u16, b: u16, beyond: Option<(usize, usize)>| {
+            clean && a.min(b) == 0 && a.max(b) > 0 && beyond.is_some_and(|(x, y)| solid(x, y))
+        };
         let h_boundary = |row: &[u16], x: usize, y: usize| -> Option<usize> {
             if x == 0 || x + 1 >= fw {
                 return None;
             }
             let (l, v, r) = (clamp(row[x - 1]), clamp(row[x]), clamp(row[x + 1]));
             let step = l.abs_diff(r);
-            if step < tau || !(keep_saturated || l.max(r) < max_dn) || !gated(x, y) {
+            let beyond = if l == 0 {
+                Some((x + 1, y))
+            } else {
+                Some((x - 1, y))
+            };
+            if (step < tau && !faint(l, r, beyond))
+                || !(keep_saturated || l.max(r) < max_dn)
+                || !gated(x, y)
+            {
                 return None;
             }
             let before = x.checked_sub(2).map_or(0, |i| clamp(row[i]).abs_diff(v));
@@ -727,7 +759,15 @@ impl Auto {
             };
             let (u, v, d) = (clamp(a[x]), clamp(v[x]), clamp(d[x]));
             let step = u.abs_diff(d);
-            if step < tau || !(keep_saturated || u.max(d) < max_dn) || !gated(x, y) {
+            let beyond = if u == 0 {
+                Some((x, y + 1))
+            } else {
+                Some((x, y - 1))
+            };
+            if (step < tau && !faint(u, d, beyond))
+                || !(keep_saturated || u.max(d) < max_dn)
+                || !gated(x, y)
+            {
                 return None;
             }
             let before = y
@@ -766,7 +806,10 @@ impl Auto {
         for y in sparse.chain(ry0..ry1) {
             let Some(row) = rows(y) else { continue };
             let quick = |x: usize| {
-                x > 0 && x + 1 < fw && clamp(row[x - 1]).abs_diff(clamp(row[x + 1])) >= tau
+                x > 0 && x + 1 < fw && {
+                    let (l, r) = (clamp(row[x - 1]), clamp(row[x + 1]));
+                    l.abs_diff(r) >= tau || (clean && l.min(r) == 0 && l.max(r) > 0)
+                }
             };
             let mut x = rx0;
             while x < lim_x0.min(rx1) && x <= found.bx.0 {
@@ -792,7 +835,8 @@ impl Auto {
             let mut hit = false;
             for x in rx0..rx1 {
                 // The cheap test first: most pixels hold no step.
-                if clamp(a[x]).abs_diff(clamp(d[x])) < tau {
+                let (u, w) = (clamp(a[x]), clamp(d[x]));
+                if u.abs_diff(w) < tau && !(clean && u.min(w) == 0 && u.max(w) > 0) {
                     continue;
                 }
                 if let Some(b) = v_boundary(x, y) {
