@@ -9,8 +9,9 @@
 //! - [`sensor`]: the camera model of the paper's Sections 3.1 and 3.3: response, band
 //!   radiance, view-factor flux, DN conversion, noise, and the frame pass.
 //! - [`frame`]: a validated, borrowed view of a DN frame ([`Frame`]).
-//! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface and the four detectors
-//!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`].
+//! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface, the four detectors
+//!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`], and our
+//!   scene-aware [`roi::auto`] (with a tracking mode).
 //! - `link` (cargo feature `spi`, on by default): frame input over SPI, CRC-checked
 //!   rows read through an embedded-hal 1.0 `SpiDevice` by `link::FrameReader`, and a
 //!   `link::SimulatedCamera` serving a stored frame.
@@ -28,6 +29,7 @@
 //! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 11 568 | 16 KiB |
 //! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 344 | 16 KiB |
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 288 | 96 KiB |
+//! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 704 | 32 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in the README.
 //!
