@@ -247,19 +247,7 @@ pub fn score(
                     bank.auto.prior = Some(jittered_prior(row.roi, &row.file));
                 }
                 for &m in &options.methods {
-                    let (d, time_us) = bank
-                        .detect_timed(m, &view, options.repeat)
-                        .map_err(|e| EvalError(format!("{}: {m}: {e}", path.display())))?;
-                    out.push(FrameScore {
-                        file: row.file.clone(),
-                        method: m.name(),
-                        bbox: d.roi.map(|r| r.to_array()),
-                        truth: row.roi.to_array(),
-                        iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
-                        time_us,
-                        groups: row.groups.clone(),
-                        range_m: row.range_m,
-                    });
+                    out.push(score_one(bank, m, &view, row, &path, options.repeat)?.0);
                 }
                 progress();
                 Ok(out)
@@ -271,6 +259,32 @@ pub fn score(
         scores.extend(r?);
     }
     Ok(scores)
+}
+
+/// Runs `method` on one frame (`repeat` times, median time) and scores its box against
+/// the row's truth; also returns the box.
+fn score_one(
+    bank: &mut DetectorBank,
+    method: Method,
+    view: &tirroi_core::Frame<'_>,
+    row: &TruthRow,
+    path: &Path,
+    repeat: usize,
+) -> Result<(FrameScore, Option<Roi>), EvalError> {
+    let (d, time_us) = bank
+        .detect_timed(method, view, repeat)
+        .map_err(|e| EvalError(format!("{}: {method}: {e}", path.display())))?;
+    let score = FrameScore {
+        file: row.file.clone(),
+        method: method.name(),
+        bbox: d.roi.map(|r| r.to_array()),
+        truth: row.roi.to_array(),
+        iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
+        time_us,
+        groups: row.groups.clone(),
+        range_m: row.range_m,
+    };
+    Ok((score, d.roi))
 }
 
 /// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, `auto`'s
@@ -298,22 +312,11 @@ fn score_sequence(
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
         bank.auto.prior = previous;
         for &m in &options.methods {
-            let (d, time_us) = bank
-                .detect_timed(m, &view, options.repeat)
-                .map_err(|e| EvalError(format!("{}: {m}: {e}", path.display())))?;
+            let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
             if m == Method::Auto {
-                previous = d.roi;
+                previous = roi;
             }
-            scores.push(FrameScore {
-                file: row.file.clone(),
-                method: m.name(),
-                bbox: d.roi.map(|r| r.to_array()),
-                truth: row.roi.to_array(),
-                iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
-                time_us,
-                groups: row.groups.clone(),
-                range_m: row.range_m,
-            });
+            scores.push(score);
         }
         progress();
     }
