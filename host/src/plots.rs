@@ -38,6 +38,7 @@ use tirroi_core::Roi;
 
 use crate::figure;
 use crate::image_io::FrameBuf;
+use crate::run::median;
 
 /// Width of single-panel figures, px.
 pub const WIDTH: u32 = 800;
@@ -1062,15 +1063,6 @@ fn fmt_tick(v: f64) -> String {
     } else {
         s
     }
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let mid = values.len() / 2;
-    values.select_nth_unstable_by(mid, f64::total_cmp);
-    values[mid]
 }
 
 /// Prewitt L2 gradient magnitudes of the interior pixels, split into (inside the truth
