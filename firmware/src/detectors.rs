@@ -33,17 +33,6 @@ impl Detectors {
         }
     }
 
-    /// Bytes of scratch memory of `method` on this target.
-    pub const fn scratch_bytes(method: Method) -> usize {
-        match method {
-            Method::Otsu => core::mem::size_of::<OtsuScratch>(),
-            Method::Adaptive => core::mem::size_of::<AdaptiveScratch>(),
-            Method::Wge => core::mem::size_of::<WgeScratch>(),
-            Method::Dog => core::mem::size_of::<DogScratch>(),
-            Method::Auto => core::mem::size_of::<AutoScratch>(),
-        }
-    }
-
     /// Runs `method` with its default parameters on `frame`.
     ///
     /// Never inlined: it is the unit the firmware counts instructions and stack in,

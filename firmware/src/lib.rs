@@ -81,7 +81,7 @@ pub fn run_demo<M: Meter>(ws: &mut Workspace<'_>, meter: &mut M, emit: &mut dyn 
     for &method in DEMO_METHODS {
         emit(&Event::Memory {
             method,
-            scratch_bytes: Detectors::scratch_bytes(method),
+            scratch_bytes: method.scratch_bytes(),
         });
     }
     for (index, embedded) in frames::FRAMES.iter().enumerate() {

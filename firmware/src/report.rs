@@ -28,7 +28,7 @@ pub enum Event {
     Memory {
         /// The detector.
         method: Method,
-        /// Bytes of its `Scratch` (`size_of`, this target's layout).
+        /// Bytes of its `Scratch` on this target ([`Method::scratch_bytes`]).
         scratch_bytes: usize,
     },
     /// A frame came in over the SPI link.
