@@ -163,8 +163,7 @@ pub struct AutoWork {
     label: [u8; GRID],
     parent: [u8; MAX_COMPONENTS + 1],
     comps: [Component; MAX_COMPONENTS + 1],
-    /// Largest steps of one band of rows per pixel, DN; noise differences of one row;
-    /// then the refinement's step flags of one row.
+    /// Largest steps of one band of rows per pixel, DN.
     steps: [u16; FRAME_WIDTH],
     /// Saturated pixels per column and per row of the refinement window.
     col_sat: [u16; FRAME_WIDTH],
@@ -265,12 +264,8 @@ fn hist_median(hist: &[u32; NOISE_BINS]) -> Option<u32> {
 /// decides: when most sampled pairs are both at 0 DN (deep space fills the frame), the
 /// only texture is the target's own shading, which must not raise the thresholds, and
 /// the second-difference estimate is used; otherwise the first.
-fn noise_sigma(
-    frame: &Frame<'_>,
-    win: Window,
-    hist: &mut [[u32; NOISE_BINS]; 2],
-    buf: &mut [u16; FRAME_WIDTH],
-) -> (u32, bool) {
+#[inline(never)]
+fn noise_sigma(frame: &Frame<'_>, win: Window, hist: &mut [[u32; NOISE_BINS]; 2]) -> (u32, bool) {
     let max_dn = frame.max_dn();
     for h in hist.iter_mut() {
         h.fill(0);
@@ -280,26 +275,9 @@ fn noise_sigma(
     let mut y = win.y0 + stride / 2;
     while y < win.y0 + win.h {
         let row = win.row(frame, y);
-        let n = row.len().saturating_sub(2);
-        let d = &mut buf[..n];
-        for (((o, &a), &b), &c) in d
-            .iter_mut()
-            .zip(row)
-            .zip(row.get(1..).unwrap_or(&[]))
-            .zip(row.get(2..).unwrap_or(&[]))
-        {
-            let (a, b, c) = (a.min(max_dn), b.min(max_dn), c.min(max_dn));
-            let skip = (a | b | c) == 0 || (a & b & c) == max_dn;
-            let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
-            *o = if skip {
-                u16::MAX
-            } else {
-                d2.min(u32::from(u16::MAX - 1)) as u16
-            };
-        }
         // Every other position is plenty for a median (about 2 600 on a full frame).
-        for (x, &v) in d.iter().enumerate().step_by(2) {
-            let (a, b) = (row[x].min(max_dn), row[x + 1].min(max_dn));
+        for abc in row.windows(3).step_by(2) {
+            let (a, b, c) = (abc[0].min(max_dn), abc[1].min(max_dn), abc[2].min(max_dn));
             pairs += 1;
             one_zero += u32::from(a.min(b) == 0 && a.max(b) > 0);
             if (a | b) == 0 {
@@ -307,8 +285,9 @@ fn noise_sigma(
             } else if (a & b) != max_dn {
                 hist[0][noise_bin(u32::from(a.abs_diff(b)))] += 1;
             }
-            if v != u16::MAX {
-                hist[1][noise_bin(u32::from(v))] += 1;
+            if (a | b | c) != 0 && (a & b & c) != max_dn {
+                let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
+                hist[1][noise_bin(d2)] += 1;
             }
         }
         y += stride;
@@ -573,7 +552,7 @@ impl Auto {
         let max_dn = frame.max_dn();
         let fw = frame.width();
         let (pw, ph) = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
-        let (sigma, clean) = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
+        let (sigma, clean) = noise_sigma(frame, win, &mut work.hist);
         let AutoWork {
             step,
             label,
@@ -640,24 +619,42 @@ impl Auto {
         // free after labelling), over the refinement window's cells.
         let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
         let (ra, rb) = ((ry0 - win.y0) / BLOCK, (ry1 - 1 - win.y0) / BLOCK + 1);
-        // Labels to roots around the winner first, so the gate is comparisons only.
+        // Every label to its root first (at most 250 finds), so the gate is
+        // comparisons only: the winner's cells dilated by one cell, along rows into
+        // `step`, then down columns into `label`.
+        for l in 1..next {
+            parent[l] = find(parent, l as u8);
+        }
+        parent[0] = 0;
+        let (cwa, cwb) = (ca.saturating_sub(1), (cb + 1).min(pw));
         for cy in ra.saturating_sub(1)..(rb + 1).min(ph) {
-            for l in &mut label[cy * pw + ca.saturating_sub(1)..cy * pw + (cb + 1).min(pw)] {
-                if *l != 0 {
-                    *l = find(parent, *l);
-                }
+            let labels = &label[cy * pw..][..pw];
+            let out = &mut step[cy * pw..][..pw];
+            for cx in cwa..cwb {
+                out[cx] = u8::from(parent[usize::from(labels[cx])] == root);
             }
-        }
-        let gate = &mut step[..];
-        for cy in ra..rb {
+            // Along the row, in place: out[cx] = w[cx − 1] | w[cx] | w[cx + 1].
+            let mut prev = if ca > 0 { out[ca - 1] } else { 0 };
             for cx in ca..cb {
-                let (ya, yb) = (cy.saturating_sub(1), (cy + 2).min(ph));
-                let (xa, xb) = (cx.saturating_sub(1), (cx + 2).min(pw));
-                let hit = (ya..yb).any(|gy| label[gy * pw + xa..gy * pw + xb].contains(&root));
-                gate[cy * pw + cx] = u8::from(hit);
+                let (w, next) = (out[cx], out.get(cx + 1).copied().unwrap_or(0));
+                out[cx] = prev | w | next;
+                prev = w;
             }
         }
-        let gate = &*gate;
+        for cy in ra..rb {
+            let row = |gy: usize| &step[gy * pw + ca..gy * pw + cb];
+            let up = row(cy.saturating_sub(1));
+            let down = row((cy + 1).min(ph - 1));
+            for (((g, &u), &m), &d) in label[cy * pw + ca..cy * pw + cb]
+                .iter_mut()
+                .zip(up)
+                .zip(row(cy))
+                .zip(down)
+            {
+                *g = u | m | d;
+            }
+        }
+        let gate = &*label;
         let gated =
             |x: usize, y: usize| gate[(y - win.y0) / BLOCK * pw + (x - win.x0) / BLOCK] != 0;
         let tau = (u32::from(self.fine_k) * sigma).min(u32::from(u16::MAX)) as u16;
@@ -666,30 +663,33 @@ impl Auto {
         let tau_unsat = tau.saturating_mul(2);
         let near_sat = max_dn.saturating_sub((4 * sigma).min(u32::from(u16::MAX)) as u16);
 
-        // Saturation counts (gated), on rows that come near saturation.
+        // Saturation counts, over the gated cells.
         let (mut sat_px, mut near_px) = (0u32, 0u32);
         let col_sat = &mut col_sat[rx0..rx1];
         let row_sat = &mut row_sat[ry0..ry1];
         col_sat.fill(0);
         row_sat.fill(0);
+        // Per pixel of the refinement rows: its cell's gate (set for each cell row).
         let gate_px = &mut mask[rx0..rx1];
+        let mut gate_row = usize::MAX;
         for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
             let Some(row) = frame.row(y) else { continue };
             let row = &row[rx0..rx1];
-            if !row.iter().any(|&v| v.min(max_dn) >= near_sat) {
-                continue;
-            }
-            for (x, g) in (rx0..rx1).zip(gate_px.iter_mut()) {
-                *g = gated(x, y);
+            let cy = (y - win.y0) / BLOCK;
+            if cy != gate_row {
+                gate_row = cy;
+                let cells = &gate[cy * pw + ca..cy * pw + cb];
+                for (px, &g) in gate_px.chunks_mut(BLOCK).zip(cells) {
+                    px.fill(g != 0);
+                }
             }
             let (mut sat_row, mut near) = (0u32, 0u32);
             for ((&v, cs), &g) in row.iter().zip(col_sat.iter_mut()).zip(gate_px.iter()) {
                 let v = v.min(max_dn);
-                let g = u16::from(g);
-                let sat = g & u16::from(v >= max_dn);
-                *cs += sat;
+                let sat = g & (v >= max_dn);
+                *cs += u16::from(sat);
                 sat_row += u32::from(sat);
-                near += u32::from(g & u16::from(v >= near_sat) & u16::from(v < max_dn));
+                near += u32::from(g & (v >= near_sat) & (v < max_dn));
             }
             *rs = sat_row as u16;
             sat_px += sat_row;
