@@ -68,6 +68,9 @@ const GRID: usize = GRID_WIDTH * GRID_HEIGHT;
 pub const MAX_COMPONENTS: usize = 250;
 /// Bins of the noise histogram (16 exact bins, then 4 per octave up to 2^16).
 const NOISE_BINS: usize = 64;
+/// The extra bin of the noise histograms that takes the samples not counted (so the
+/// sampling loop has no branches).
+const SKIP_BIN: usize = NOISE_BINS;
 
 /// Parameters of the `auto` detector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -163,12 +166,13 @@ pub struct AutoWork {
     label: [u8; GRID],
     parent: [u8; MAX_COMPONENTS + 1],
     comps: [Component; MAX_COMPONENTS + 1],
-    /// Largest steps of one band of rows per pixel, DN.
+    /// Largest steps of one band of rows per pixel, DN (first one clamped row of the
+    /// noise estimate).
     steps: [u16; FRAME_WIDTH],
     /// Saturated pixels per column and per row of the refinement window.
     col_sat: [u16; FRAME_WIDTH],
     row_sat: [u16; FRAME_HEIGHT],
-    hist: [[u32; NOISE_BINS]; 2],
+    hist: [[u32; NOISE_BINS + 1]; 2],
     /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
     /// of [`Detector::foreground`].
     mask: [bool; FRAME_WIDTH],
@@ -193,7 +197,7 @@ impl AutoScratch {
                 steps: [0; FRAME_WIDTH],
                 col_sat: [0; FRAME_WIDTH],
                 row_sat: [0; FRAME_HEIGHT],
-                hist: [[0; NOISE_BINS]; 2],
+                hist: [[0; NOISE_BINS + 1]; 2],
                 mask: [false; FRAME_WIDTH],
             },
             roi: RoiBuilder::new(),
@@ -240,7 +244,7 @@ fn bin_value(b: usize) -> u32 {
 
 /// Median of the values counted in `hist` (`None` below 16 counts): the middle of
 /// its bin.
-fn hist_median(hist: &[u32; NOISE_BINS]) -> Option<u32> {
+fn hist_median(hist: &[u32]) -> Option<u32> {
     let n: u32 = hist.iter().sum();
     if n < 16 {
         return None;
@@ -265,7 +269,12 @@ fn hist_median(hist: &[u32; NOISE_BINS]) -> Option<u32> {
 /// only texture is the target's own shading, which must not raise the thresholds, and
 /// the second-difference estimate is used; otherwise the first.
 #[inline(never)]
-fn noise_sigma(frame: &Frame<'_>, win: Window, hist: &mut [[u32; NOISE_BINS]; 2]) -> (u32, bool) {
+fn noise_sigma(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [[u32; NOISE_BINS + 1]; 2],
+    buf: &mut [u16; FRAME_WIDTH],
+) -> (u32, bool) {
     let max_dn = frame.max_dn();
     for h in hist.iter_mut() {
         h.fill(0);
@@ -275,25 +284,35 @@ fn noise_sigma(frame: &Frame<'_>, win: Window, hist: &mut [[u32; NOISE_BINS]; 2]
     let mut y = win.y0 + stride / 2;
     while y < win.y0 + win.h {
         let row = win.row(frame, y);
+        let clamped = &mut buf[..row.len()];
+        for (c, &v) in clamped.iter_mut().zip(row) {
+            *c = v.min(max_dn);
+        }
         // Every other position is plenty for a median (about 2 600 on a full frame).
-        for abc in row.windows(3).step_by(2) {
-            let (a, b, c) = (abc[0].min(max_dn), abc[1].min(max_dn), abc[2].min(max_dn));
+        for abc in clamped.windows(3).step_by(2) {
+            let (a, b, c) = (abc[0], abc[1], abc[2]);
+            let both_zero = (a | b) == 0;
             pairs += 1;
-            one_zero += u32::from(a.min(b) == 0 && a.max(b) > 0);
-            if (a | b) == 0 {
-                zero_pairs += 1;
-            } else if (a & b) != max_dn {
-                hist[0][noise_bin(u32::from(a.abs_diff(b)))] += 1;
-            }
-            if (a | b | c) != 0 && (a & b & c) != max_dn {
-                let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
-                hist[1][noise_bin(d2)] += 1;
-            }
+            zero_pairs += u32::from(both_zero);
+            one_zero += u32::from((a.min(b) == 0) & !both_zero);
+            let first = if both_zero | ((a & b) == max_dn) {
+                SKIP_BIN
+            } else {
+                noise_bin(u32::from(a.abs_diff(b)))
+            };
+            hist[0][first] += 1;
+            let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
+            let second = if ((a | b | c) == 0) | ((a & b & c) == max_dn) {
+                SKIP_BIN
+            } else {
+                noise_bin(d2)
+            };
+            hist[1][second] += 1;
         }
         y += stride;
     }
-    let first = hist_median(&hist[0]).map(|m| (m * 21 + 10) / 20);
-    let second = hist_median(&hist[1]).map(|m| (m * 20 + 16) / 33);
+    let first = hist_median(&hist[0][..NOISE_BINS]).map(|m| (m * 21 + 10) / 20);
+    let second = hist_median(&hist[1][..NOISE_BINS]).map(|m| (m * 20 + 16) / 33);
     let space = 2 * zero_pairs > pairs;
     let sigma = if space {
         second.or(first)
@@ -400,11 +419,14 @@ fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usize) -> Opti
 /// absolute difference of a pixel and the pixel two to its right or two below, on
 /// every other row (so every boundary between two pixels is spanned once per column
 /// and per pair of rows, at half the cost of neighbour differences on every row), in
-/// units of σ/4, as a [`step_code`]. `band` holds the per-pixel maxima of one band of rows.
+/// units of σ/4, as a [`step_code`]; steps below `floor` (σ/4) as 0, which no edge
+/// threshold reaches (the code is computed only for cells that may be edge cells).
+/// `band` holds the per-pixel maxima of one band of rows.
 fn step_plane(
     frame: &Frame<'_>,
     win: Window,
     sigma: u32,
+    floor: u32,
     pw: usize,
     band: &mut [u16; FRAME_WIDTH],
     plane: &mut [u8],
@@ -414,6 +436,10 @@ fn step_plane(
     let band = &mut band[..n];
     // q = cm · 4/σ, as a 16.16 reciprocal.
     let inv = (4u64 << 16) / u64::from(sigma.max(1));
+    let code = |cm: u16| {
+        let v = ((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32;
+        if v < floor { 0 } else { step_code(v) }
+    };
     let c = |v: u16| v.min(max_dn);
     let last = win.y0 + win.h - 1;
     for (cy, plane_row) in plane.chunks_exact_mut(pw).enumerate() {
@@ -438,12 +464,12 @@ fn step_plane(
         let mut cells = band.chunks_exact(BLOCK);
         for (q, chunk) in plane_row.iter_mut().zip(&mut cells) {
             let cm = chunk[0].max(chunk[1]).max(chunk[2]).max(chunk[3]);
-            *q = step_code(((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32);
+            *q = code(cm);
         }
         // A partial cell at the right edge.
         if let (Some(q), false) = (plane_row.get_mut(n / BLOCK), cells.remainder().is_empty()) {
             let cm = cells.remainder().iter().fold(0u16, |m, &v| m.max(v));
-            *q = step_code(((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32);
+            *q = code(cm);
         }
     }
 }
@@ -552,7 +578,7 @@ impl Auto {
         let max_dn = frame.max_dn();
         let fw = frame.width();
         let (pw, ph) = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
-        let (sigma, clean) = noise_sigma(frame, win, &mut work.hist);
+        let (sigma, clean) = noise_sigma(frame, win, &mut work.hist, &mut work.steps);
         let AutoWork {
             step,
             label,
@@ -566,13 +592,14 @@ impl Auto {
         } = work;
         let label = &mut label[..pw * ph];
         let step = &mut step[..pw * ph];
-        step_plane(frame, win, sigma, pw, steps, step);
-
         // Edge cells (step ≥ coarse_k·σ), labelled in raster order (8-connected,
         // union-find on u8 labels, statistics merged on union). A frame with more
         // components than labels (noise, texture) is labelled again with a threshold
-        // half as high again, up to four times.
+        // half as high again, up to four times; so no cell below the first threshold's
+        // code is ever an edge cell.
         let mut threshold = step_code(u32::from(self.coarse_k) * 4);
+        step_plane(frame, win, sigma, step_value(threshold), pw, steps, step);
+
         let mut next = None;
         for _ in 0..4 {
             next = label_edges(step, label, pw, threshold, parent, comps);
@@ -675,6 +702,11 @@ impl Auto {
         for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
             let Some(row) = frame.row(y) else { continue };
             let row = &row[rx0..rx1];
+            // Most rows of a radiometry frame hold no pixel near saturation (a max is
+            // cheaper than the counts).
+            if row.iter().fold(0, |m, &v| m.max(v)) < near_sat {
+                continue;
+            }
             let cy = (y - win.y0) / BLOCK;
             if cy != gate_row {
                 gate_row = cy;
@@ -683,14 +715,16 @@ impl Auto {
                     px.fill(g != 0);
                 }
             }
-            let (mut sat_row, mut near) = (0u32, 0u32);
+            // (v ≥ max_dn is v saturated; near_sat ≤ max_dn: no clamp needed.)
+            let (mut sat_row, mut near) = (0u16, 0u16);
             for ((&v, cs), &g) in row.iter().zip(col_sat.iter_mut()).zip(gate_px.iter()) {
-                let v = v.min(max_dn);
-                let sat = g & (v >= max_dn);
-                *cs += u16::from(sat);
-                sat_row += u32::from(sat);
-                near += u32::from(g & (v >= near_sat) & (v < max_dn));
+                let g = u16::from(g);
+                let sat = g & u16::from(v >= max_dn);
+                *cs += sat;
+                sat_row += sat;
+                near += g & u16::from(v >= near_sat) & u16::from(v < max_dn);
             }
+            let (sat_row, near) = (u32::from(sat_row), u32::from(near));
             *rs = sat_row as u16;
             sat_px += sat_row;
             near_px += near;
@@ -801,42 +835,53 @@ impl Auto {
             )
         });
         let mut found = Boundaries::NONE;
+        // The cheap test of a pixel pair (clamped) before the boundary tests: a step of
+        // τ, or (clean deep space) 0 DN beside a pixel above it.
+        let candidate =
+            |l: u16, r: u16| l.abs_diff(r) >= tau || (clean && l.min(r) == 0 && l.max(r) > 0);
         // One row per cell band first (cheap bounds for the rest), then every row.
         let sparse = (ry0 + BLOCK / 2..ry1).step_by(BLOCK);
         for y in sparse.chain(ry0..ry1) {
             let Some(row) = rows(y) else { continue };
-            let quick = |x: usize| {
-                x > 0 && x + 1 < fw && {
-                    let (l, r) = (clamp(row[x - 1]), clamp(row[x + 1]));
-                    l.abs_diff(r) >= tau || (clean && l.min(r) == 0 && l.max(r) > 0)
+            // Pixels x of [xa, xb) with both neighbours in the frame, first to last (or
+            // last to first): the first boundary found.
+            let scan = |xa: usize, xb: usize, backwards: bool| {
+                let (xa, xb) = (xa.max(1), xb.min(fw - 1));
+                let triples = row.get(xa.wrapping_sub(1)..xb + 1).filter(|_| xa < xb)?;
+                let mut hits = (xa..xb)
+                    .zip(triples.windows(3))
+                    .filter(|(_, t)| candidate(clamp(t[0]), clamp(t[2])));
+                if backwards {
+                    hits.rev().find_map(|(x, _)| h_boundary(row, x, y))
+                } else {
+                    hits.find_map(|(x, _)| h_boundary(row, x, y))
                 }
             };
-            let mut x = rx0;
-            while x < lim_x0.min(rx1) && x <= found.bx.0 {
-                if let Some(b) = quick(x).then(|| h_boundary(row, x, y)).flatten() {
-                    found.add_x(b, y);
-                    break;
-                }
-                x += 1;
+            let left_end = lim_x0.min(rx1).min(found.bx.0.saturating_add(1));
+            if let Some(b) = scan(rx0, left_end, false) {
+                found.add_x(b, y);
             }
-            let mut x = rx1;
-            while x > rx0.max(lim_x1) && x >= found.bx.1 {
-                x -= 1;
-                if let Some(b) = quick(x).then(|| h_boundary(row, x, y)).flatten() {
-                    found.add_x(b, y);
-                    break;
-                }
+            let right_start = rx0.max(lim_x1).max(found.bx.1.saturating_sub(1));
+            if let Some(b) = scan(right_start, rx1, true) {
+                found.add_x(b, y);
             }
         }
         let vertical = |y: usize, found: &mut Boundaries| {
             let (Some(a), Some(d)) = (y.checked_sub(1).and_then(rows), rows(y + 1)) else {
                 return false;
             };
+            // Most rows hold no candidate: one pass that vectorises says so.
+            let (a, d) = (&a[rx0..rx1], &d[rx0..rx1]);
+            let largest = a
+                .iter()
+                .zip(d)
+                .fold(0, |m, (&u, &w)| m.max(clamp(u).abs_diff(clamp(w))));
+            if largest < tau && !(clean && a.iter().zip(d).any(|(&u, &w)| (u == 0) != (w == 0))) {
+                return false;
+            }
             let mut hit = false;
-            for x in rx0..rx1 {
-                // The cheap test first: most pixels hold no step.
-                let (u, w) = (clamp(a[x]), clamp(d[x]));
-                if u.abs_diff(w) < tau && !(clean && u.min(w) == 0 && u.max(w) > 0) {
+            for (x, (&u, &w)) in (rx0..rx1).zip(a.iter().zip(d)) {
+                if !candidate(clamp(u), clamp(w)) {
                     continue;
                 }
                 if let Some(b) = v_boundary(x, y) {
@@ -1005,6 +1050,11 @@ mod tests {
                     back <= v && 17 * u64::from(back) >= 16 * u64::from(v) - 16,
                     "{v} {c} {back}"
                 );
+                // `back` is the bottom of the code: the floor of `step_plane`.
+                if c > 0 {
+                    assert_eq!(step_code(back), c, "{v}");
+                    assert!(step_code(back - 1) < c, "{v}");
+                }
             }
         }
         assert_eq!(step_code(1), 0);
