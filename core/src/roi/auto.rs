@@ -172,7 +172,8 @@ pub struct AutoWork {
     /// Saturated pixels per column and per row of the refinement window.
     col_sat: [u16; FRAME_WIDTH],
     row_sat: [u16; FRAME_HEIGHT],
-    hist: [[u32; NOISE_BINS + 1]; 2],
+    /// Histogram of one noise estimate.
+    hist: [u32; NOISE_BINS + 1],
     /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
     /// of [`Detector::foreground`].
     mask: [bool; FRAME_WIDTH],
@@ -197,7 +198,7 @@ impl AutoScratch {
                 steps: [0; FRAME_WIDTH],
                 col_sat: [0; FRAME_WIDTH],
                 row_sat: [0; FRAME_HEIGHT],
-                hist: [[0; NOISE_BINS + 1]; 2],
+                hist: [0; NOISE_BINS + 1],
                 mask: [false; FRAME_WIDTH],
             },
             roi: RoiBuilder::new(),
@@ -258,66 +259,90 @@ fn hist_median(hist: &[u32]) -> Option<u32> {
         .map(bin_value)
 }
 
-/// Pixel noise σ in DN (≥ 1) of `win`, from horizontal differences on at most 16
-/// evenly spaced rows (every other position; runs at 0 DN or saturated are skipped:
-/// clipped noise says nothing).
-///
-/// Two estimates: first differences `|b − a|` (σ = median / 0.954), which also see the
-/// Earth's smooth texture, so that texture stays below the edge thresholds; and second
-/// differences `|a − 2b + c|` (σ = median / 1.652), blind to smooth shading. The scene
-/// decides: when most sampled pairs are both at 0 DN (deep space fills the frame), the
-/// only texture is the target's own shading, which must not raise the thresholds, and
-/// the second-difference estimate is used; otherwise the first.
-#[inline(never)]
-fn noise_sigma(
+/// Calls `f(a, b, c)` with the clamped pixels at `x, x + 1, x + 2` for every other `x`
+/// of at most 16 evenly spaced rows of `win` (about 2 600 samples on a full frame:
+/// plenty for a median). `buf` holds one clamped row.
+fn for_each_noise_sample(
     frame: &Frame<'_>,
     win: Window,
-    hist: &mut [[u32; NOISE_BINS + 1]; 2],
     buf: &mut [u16; FRAME_WIDTH],
-) -> (u32, bool) {
+    mut f: impl FnMut(u16, u16, u16),
+) {
     let max_dn = frame.max_dn();
-    for h in hist.iter_mut() {
-        h.fill(0);
-    }
-    let (mut pairs, mut zero_pairs, mut one_zero) = (0u32, 0u32, 0u32);
     let stride = (win.h / 16).max(1);
-    let mut y = win.y0 + stride / 2;
-    while y < win.y0 + win.h {
+    for y in (win.y0 + stride / 2..win.y0 + win.h).step_by(stride) {
         let row = win.row(frame, y);
         let clamped = &mut buf[..row.len()];
         for (c, &v) in clamped.iter_mut().zip(row) {
             *c = v.min(max_dn);
         }
-        // Every other position is plenty for a median (about 2 600 on a full frame).
         for abc in clamped.windows(3).step_by(2) {
-            let (a, b, c) = (abc[0], abc[1], abc[2]);
-            let both_zero = (a | b) == 0;
-            pairs += 1;
-            zero_pairs += u32::from(both_zero);
-            one_zero += u32::from((a.min(b) == 0) & !both_zero);
-            let first = if both_zero | ((a & b) == max_dn) {
-                SKIP_BIN
-            } else {
-                noise_bin(u32::from(a.abs_diff(b)))
-            };
-            hist[0][first] += 1;
-            let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
-            let second = if ((a | b | c) == 0) | ((a & b & c) == max_dn) {
-                SKIP_BIN
-            } else {
-                noise_bin(d2)
-            };
-            hist[1][second] += 1;
+            f(abc[0], abc[1], abc[2]);
         }
-        y += stride;
     }
-    let first = hist_median(&hist[0][..NOISE_BINS]).map(|m| (m * 21 + 10) / 20);
-    let second = hist_median(&hist[1][..NOISE_BINS]).map(|m| (m * 20 + 16) / 33);
+}
+
+/// σ in DN from the median of the first differences `|b − a|` (σ = median / 0.954;
+/// pairs both at 0 DN or both saturated skipped) or, with `SECOND`, of the second
+/// differences `|a − 2b + c|` (σ = median / 1.652; triples all at 0 DN or all
+/// saturated skipped); `None` below 16 samples.
+fn difference_sigma<const SECOND: bool>(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [u32; NOISE_BINS + 1],
+    buf: &mut [u16; FRAME_WIDTH],
+) -> Option<u32> {
+    let max_dn = frame.max_dn();
+    hist.fill(0);
+    for_each_noise_sample(frame, win, buf, |a, b, c| {
+        let (skip, d) = if SECOND {
+            let d2 = (i32::from(a) + i32::from(c) - 2 * i32::from(b)).unsigned_abs();
+            (((a | b | c) == 0) | ((a & b & c) == max_dn), d2)
+        } else {
+            let d1 = u32::from(a.abs_diff(b));
+            (((a | b) == 0) | ((a & b) == max_dn), d1)
+        };
+        hist[if skip { SKIP_BIN } else { noise_bin(d) }] += 1;
+    });
+    let m = hist_median(&hist[..NOISE_BINS])?;
+    Some(if SECOND {
+        (m * 20 + 16) / 33
+    } else {
+        (m * 21 + 10) / 20
+    })
+}
+
+/// Pixel noise σ in DN (≥ 1) of `win`, from horizontal differences (see
+/// [`for_each_noise_sample`]; runs at 0 DN or saturated are skipped: clipped noise
+/// says nothing), and whether deep space is clean (see below).
+///
+/// Two estimates: first differences, which also see the Earth's smooth texture, so
+/// that texture stays below the edge thresholds; and second differences, blind to
+/// smooth shading. The scene decides: when most sampled pairs are both at 0 DN (deep
+/// space fills the frame), the only texture is the target's own shading, which must
+/// not raise the thresholds, and the second-difference estimate is used; otherwise the
+/// first. A first pass counts the pairs at 0 DN; only the histogram the scene needs
+/// is built (the other one too when that one has too few samples).
+fn noise_sigma(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [u32; NOISE_BINS + 1],
+    buf: &mut [u16; FRAME_WIDTH],
+) -> (u32, bool) {
+    let (mut pairs, mut zero_pairs, mut one_zero) = (0u32, 0u32, 0u32);
+    for_each_noise_sample(frame, win, buf, |a, b, _| {
+        let both_zero = (a | b) == 0;
+        pairs += 1;
+        zero_pairs += u32::from(both_zero);
+        one_zero += u32::from((a.min(b) == 0) & !both_zero);
+    });
     let space = 2 * zero_pairs > pairs;
     let sigma = if space {
-        second.or(first)
+        difference_sigma::<true>(frame, win, hist, buf)
+            .or_else(|| difference_sigma::<false>(frame, win, hist, buf))
     } else {
-        first.or(second)
+        difference_sigma::<false>(frame, win, hist, buf)
+            .or_else(|| difference_sigma::<true>(frame, win, hist, buf))
     };
     // Clean deep space: at 0 DN nearly everywhere (sunlit frames), with at most a
     // sparse sprinkle of clipped-noise pixels (noise clipped at 0 around a level at 0
@@ -436,9 +461,15 @@ fn step_plane(
     let band = &mut band[..n];
     // q = cm · 4/σ, as a 16.16 reciprocal.
     let inv = (4u64 << 16) / u64::from(sigma.max(1));
+    // The smallest step in DN whose σ/4 units reach `floor`: cm · inv ≥ floor · 2^16.
+    let cm_floor = (u64::from(floor) << 16).div_ceil(inv.max(1));
     let code = |cm: u16| {
         let v = ((u64::from(cm) * inv) >> 16).min(u64::from(u32::MAX)) as u32;
-        if v < floor { 0 } else { step_code(v) }
+        if u64::from(cm) < cm_floor {
+            0
+        } else {
+            step_code(v)
+        }
     };
     let c = |v: u16| v.min(max_dn);
     let last = win.y0 + win.h - 1;
@@ -460,6 +491,12 @@ fn step_plane(
             for x in n.saturating_sub(span)..n {
                 band[x] = band[x].max(c(row[x]).abs_diff(c(below[x])));
             }
+        }
+        // Most bands hold no step that may make an edge cell: one pass that
+        // vectorises says so.
+        if u64::from(band.iter().fold(0, |m, &v| m.max(v))) < cm_floor {
+            plane_row.fill(0);
+            continue;
         }
         let mut cells = band.chunks_exact(BLOCK);
         for (q, chunk) in plane_row.iter_mut().zip(&mut cells) {
