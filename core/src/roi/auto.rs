@@ -164,7 +164,8 @@ pub struct AutoWork {
     step: [u8; GRID],
     /// Per cell of the window: its component label (0: not an edge cell).
     label: [u8; GRID],
-    parent: [u8; MAX_COMPONENTS + 1],
+    /// Union-find parents of the labels (256 entries: any `u8` label indexes it).
+    parent: [u8; 256],
     comps: [Component; MAX_COMPONENTS + 1],
     /// Largest steps of one band of rows per pixel, DN (first one clamped row of the
     /// noise estimate).
@@ -193,7 +194,7 @@ impl AutoScratch {
             work: AutoWork {
                 step: [0; GRID],
                 label: [0; GRID],
-                parent: [0; MAX_COMPONENTS + 1],
+                parent: [0; 256],
                 comps: [NO_COMPONENT; MAX_COMPONENTS + 1],
                 steps: [0; FRAME_WIDTH],
                 col_sat: [0; FRAME_WIDTH],
@@ -520,7 +521,7 @@ fn label_edges(
     plane: &mut [u8],
     pw: usize,
     threshold: u8,
-    parent: &mut [u8; MAX_COMPONENTS + 1],
+    parent: &mut [u8; 256],
     comps: &mut [Component; MAX_COMPONENTS + 1],
 ) -> Option<usize> {
     let mut next = 1usize;
@@ -597,7 +598,7 @@ fn step_value(code: u8) -> u32 {
 }
 
 /// Root of component `l`, halving the path.
-fn find(parent: &mut [u8; MAX_COMPONENTS + 1], mut l: u8) -> u8 {
+fn find(parent: &mut [u8; 256], mut l: u8) -> u8 {
     loop {
         let p = parent[usize::from(l)];
         if p == l {
@@ -691,18 +692,20 @@ impl Auto {
         }
         parent[0] = 0;
         let (cwa, cwb) = (ca.saturating_sub(1), (cb + 1).min(pw));
+        // The winner's cells of one cell row, padded by a cell on each side:
+        // `winner[cx + 1]` is cell cx.
+        let winner = &mut mask[..pw + 2];
+        winner.fill(false);
         for cy in ra.saturating_sub(1)..(rb + 1).min(ph) {
-            let labels = &label[cy * pw..][..pw];
-            let out = &mut step[cy * pw..][..pw];
-            for cx in cwa..cwb {
-                out[cx] = u8::from(parent[usize::from(labels[cx])] == root);
+            let labels = &label[cy * pw + cwa..cy * pw + cwb];
+            for (w, &l) in winner[cwa + 1..cwb + 1].iter_mut().zip(labels) {
+                *w = parent[usize::from(l)] == root;
             }
-            // Along the row, in place: out[cx] = w[cx − 1] | w[cx] | w[cx + 1].
-            let mut prev = if ca > 0 { out[ca - 1] } else { 0 };
-            for cx in ca..cb {
-                let (w, next) = (out[cx], out.get(cx + 1).copied().unwrap_or(0));
-                out[cx] = prev | w | next;
-                prev = w;
+            // Along the row: out[cx] = w[cx − 1] | w[cx] | w[cx + 1].
+            let out = &mut step[cy * pw + ca..cy * pw + cb];
+            let (left, mid, right) = (&winner[ca..cb], &winner[ca + 1..], &winner[ca + 2..]);
+            for (((o, &l), &m), &r) in out.iter_mut().zip(left).zip(mid).zip(right) {
+                *o = u8::from(l | m | r);
             }
         }
         for cy in ra..rb {
@@ -733,9 +736,10 @@ impl Auto {
         let row_sat = &mut row_sat[ry0..ry1];
         col_sat.fill(0);
         row_sat.fill(0);
-        // Per pixel of the refinement rows: its cell's gate (set for each cell row).
-        let gate_px = &mut mask[rx0..rx1];
-        let mut gate_row = usize::MAX;
+        // Runs of gated cells of a cell row as pixel ranges relative to rx0 (set for
+        // each cell row): the counts touch gated pixels only, a slice per run.
+        let mut runs = [(0u16, 0u16); GRID_WIDTH / 2 + 1];
+        let (mut n_runs, mut runs_row) = (0, usize::MAX);
         for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
             let Some(row) = frame.row(y) else { continue };
             let row = &row[rx0..rx1];
@@ -745,21 +749,36 @@ impl Auto {
                 continue;
             }
             let cy = (y - win.y0) / BLOCK;
-            if cy != gate_row {
-                gate_row = cy;
+            if cy != runs_row {
+                runs_row = cy;
+                n_runs = 0;
                 let cells = &gate[cy * pw + ca..cy * pw + cb];
-                for (px, &g) in gate_px.chunks_mut(BLOCK).zip(cells) {
-                    px.fill(g != 0);
+                let mut open = None;
+                for (i, &g) in cells.iter().chain(&[0]).enumerate() {
+                    match (open, g != 0) {
+                        (None, true) => open = Some(i),
+                        (Some(start), false) => {
+                            let px = |c: usize| (c * BLOCK).min(row.len()) as u16;
+                            if let Some(r) = runs.get_mut(n_runs) {
+                                *r = (px(start), px(i));
+                                n_runs += 1;
+                            }
+                            open = None;
+                        }
+                        _ => {}
+                    }
                 }
             }
             // (v ≥ max_dn is v saturated; near_sat ≤ max_dn: no clamp needed.)
             let (mut sat_row, mut near) = (0u16, 0u16);
-            for ((&v, cs), &g) in row.iter().zip(col_sat.iter_mut()).zip(gate_px.iter()) {
-                let g = u16::from(g);
-                let sat = g & u16::from(v >= max_dn);
-                *cs += sat;
-                sat_row += sat;
-                near += g & u16::from(v >= near_sat) & u16::from(v < max_dn);
+            for &(a, b) in &runs[..n_runs] {
+                let (a, b) = (usize::from(a), usize::from(b));
+                for (&v, cs) in row[a..b].iter().zip(&mut col_sat[a..b]) {
+                    let sat = u16::from(v >= max_dn);
+                    *cs += sat;
+                    sat_row += sat;
+                    near += u16::from(v >= near_sat) & (1 - sat);
+                }
             }
             let (sat_row, near) = (u32::from(sat_row), u32::from(near));
             *rs = sat_row as u16;
