@@ -175,8 +175,8 @@ pub struct AutoWork {
     row_sat: [u16; FRAME_HEIGHT],
     /// Histogram of one noise estimate.
     hist: [u32; NOISE_BINS + 1],
-    /// The refinement's gate (pixels whose cell neighbours the winner), or a mask row
-    /// of [`Detector::foreground`].
+    /// The winner's cells of one cell row, padded by a cell on each side (building the
+    /// gate), or a mask row of [`Detector::foreground`].
     mask: [bool; FRAME_WIDTH],
 }
 
