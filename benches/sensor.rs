@@ -1,7 +1,8 @@
 //! Criterion benchmarks of the camera model: run time of the three band-radiance paths
 //! (exact f64 quadrature, f32 quadrature, f32 table) and of a full-frame DN + noise
-//! pass. Their errors are measured by tests/sensor_radiance.rs (`cargo test --test
-//! sensor_radiance -- --nocapture` prints the worst relative error of each path).
+//! pass. Their errors are measured by core/tests/sensor_radiance.rs (`cargo test -p
+//! tirroi-core --test sensor_radiance -- --nocapture` prints the worst relative error of
+//! each path).
 //! `cargo bench --bench sensor`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """High-precision band radiance of the TIR response model: the reference table the
-core's band-radiance tests compare against (tests/data/band_radiance_reference.csv).
+core's band-radiance tests compare against (core/tests/data/band_radiance_reference.csv).
 
 Run once, with mpmath only (pure Python, no numpy):
 
     python3 -m pip install mpmath          # tested with mpmath 1.3.0 and 1.4.1
-    python3 scripts/reference/band_radiance.py > tests/data/band_radiance_reference.csv
+    python3 scripts/reference/band_radiance.py > core/tests/data/band_radiance_reference.csv
 
 Takes about 3-5 minutes. Method (adopted from the project's shared reference,
 shared/reference/reference.py, section 3, and checked against its 30-digit table):

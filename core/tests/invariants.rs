@@ -15,12 +15,12 @@ use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;
 use proptest::test_runner::RngSeed;
-use tirroi::core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
-use tirroi::core::roi::adaptive::Adaptive;
-use tirroi::core::roi::dog::Dog;
-use tirroi::core::roi::otsu::Otsu;
-use tirroi::core::roi::wge::Wge;
-use tirroi::core::{BoxRule, DetectError, Detection, Roi};
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+use tirroi_core::roi::adaptive::Adaptive;
+use tirroi_core::roi::dog::Dog;
+use tirroi_core::roi::otsu::Otsu;
+use tirroi_core::roi::wge::Wge;
+use tirroi_core::{BoxRule, DetectError, Detection, Roi};
 
 const W: usize = FRAME_WIDTH;
 const H: usize = FRAME_HEIGHT;

@@ -1,10 +1,10 @@
 //! The scale of the paper's detection mode (Eq. 4, Table 5) under the chosen sensing
 //! area ΔA_c, against `shared/reference/REFERENCE.md` §4.
 
-use tirroi::core::sensor::dn::EARTH_MAX_FLUX_TABLE5_W_M2;
-use tirroi::core::sensor::flux::{distance_compensation, facet_flux_w_m2};
-use tirroi::core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
-use tirroi::core::sensor::{BandRadiance, DetectionScale, DnMapping, SENSOR_AREA_M2};
+use tirroi_core::sensor::dn::EARTH_MAX_FLUX_TABLE5_W_M2;
+use tirroi_core::sensor::flux::{distance_compensation, facet_flux_w_m2};
+use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
+use tirroi_core::sensor::{BandRadiance, DetectionScale, DnMapping, SENSOR_AREA_M2};
 
 /// Camera–Earth distance of the paper's dataset, m (4 500 km altitude).
 const EARTH_DISTANCE_M: f64 = 10_871e3;

@@ -2,8 +2,8 @@
 //! parameter errors, and no-panic / box-inside-frame invariants (proptest).
 
 use proptest::prelude::*;
-use tirroi::core::roi::auto::{self, Auto, AutoScratch};
-use tirroi::core::{DetectError, Detector, Frame, Method, Roi};
+use tirroi_core::roi::auto::{self, Auto, AutoScratch};
+use tirroi_core::{DetectError, Detector, Frame, Method, Roi};
 
 const W: usize = 328;
 const H: usize = 248;

@@ -1,6 +1,7 @@
-//! Shared helpers of the cross-crate tests: a seeded generator, ASCII-art frames and
-//! masks, frame and mask generators, a spy that records a detector's mask, and
-//! brute-force references of every detector's documented semantics.
+//! Shared helpers of the core's integration tests (std, no host): a seeded generator,
+//! the committed fixture frames, ASCII-art frames and masks, frame and mask generators,
+//! a spy that records a detector's mask, and brute-force references of every
+//! detector's documented semantics.
 //!
 //! The references are written from the module documentation only (never by calling a
 //! detector's internals): they are deliberately slow and obvious.
@@ -11,12 +12,12 @@
 use std::cell::RefCell;
 use std::collections::HashSet;
 
-use tirroi::core::roi::Scratch;
-use tirroi::core::roi::adaptive::{Adaptive, AdaptiveScratch};
-use tirroi::core::roi::dog::{Dog, DogScratch};
-use tirroi::core::roi::otsu::{Otsu, OtsuScratch};
-use tirroi::core::roi::wge::{Wge, WgeScratch};
-use tirroi::core::{BoxRule, DetectError, Detection, Detector, Frame, Roi};
+use tirroi_core::roi::Scratch;
+use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
+use tirroi_core::roi::dog::{Dog, DogScratch};
+use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
+use tirroi_core::roi::wge::{Wge, WgeScratch};
+use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Roi};
 
 // ---------------------------------------------------------------------------------
 // Seeded generator
@@ -888,19 +889,80 @@ pub fn distinct(px: &[u16]) -> usize {
 /// Both box rules.
 pub const RULES: [BoxRule; 2] = [BoxRule::AllForeground, BoxRule::LargestComponent];
 
-/// The host's procedural fixture frames as test images, with their names.
-pub fn fixture_imgs() -> Vec<(&'static str, Img)> {
-    tirroi::host::fixture::standard_set()
-        .into_iter()
-        .map(|(name, spec)| {
-            let frame = tirroi::host::fixture::render(&spec).frame;
-            let img = Img {
-                px: frame.pixels,
-                w: frame.width,
-                h: frame.height,
-                bits: frame.bits,
-            };
-            (name, img)
+/// The committed fixture frames, in the order of `truth.csv`: `(name, file)`.
+pub const FIXTURES: [(&str, &str); 4] = [
+    ("deep-space", "deep-space.png"),
+    ("earth", "earth.png"),
+    ("earth-close", "earth-close.png"),
+    ("earth-far", "earth-far.png"),
+];
+
+/// The folder of the committed fixture frames (see its README).
+pub fn fixtures_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fixtures")
+}
+
+/// The committed `truth.csv`: every fixture file with the exact box of its target.
+pub fn fixture_truth() -> Vec<(String, Roi)> {
+    let path = fixtures_dir().join("truth.csv");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("file,x0,y0,x1,y1"), "truth.csv header");
+    lines
+        .map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            assert_eq!(f.len(), 5, "truth.csv line {line:?}");
+            let n = |i: usize| -> u16 { f[i].parse().expect("truth.csv coordinate") };
+            (f[0].to_string(), Roi::new(n(1), n(2), n(3), n(4)))
         })
+        .collect()
+}
+
+/// Reads a committed 16-bit grayscale PNG as a 14-bit test image (the fixtures are
+/// 14-bit DN stored unscaled in 16-bit samples).
+pub fn read_png14(path: &std::path::Path) -> Img {
+    let file = std::fs::File::open(path)
+        .unwrap_or_else(|e| panic!("{}: cannot open: {e}", path.display()));
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::IDENTITY);
+    let mut reader = decoder
+        .read_info()
+        .unwrap_or_else(|e| panic!("{}: not a PNG: {e}", path.display()));
+    let mut buf = vec![0u8; reader.output_buffer_size().expect("small frame")];
+    let info = reader
+        .next_frame(&mut buf)
+        .unwrap_or_else(|e| panic!("{}: cannot decode: {e}", path.display()));
+    assert_eq!(
+        (info.color_type, info.bit_depth),
+        (png::ColorType::Grayscale, png::BitDepth::Sixteen),
+        "{}: fixtures are 16-bit grayscale",
+        path.display()
+    );
+    let (w, h) = (info.width as usize, info.height as usize);
+    let px: Vec<u16> = buf[..w * h * 2]
+        .chunks_exact(2)
+        .map(|b| u16::from_be_bytes([b[0], b[1]]))
+        .collect();
+    let img = Img { px, w, h, bits: 14 };
+    assert!(
+        img.px.iter().all(|&v| v <= img.max_dn()),
+        "{}: DN above 14 bits",
+        path.display()
+    );
+    img
+}
+
+/// The host's procedural fixture frames (`tirroi fixtures`, committed in
+/// `core/tests/data/fixtures/`) as test images, with their names. The root test
+/// `tests/fixture_data.rs` checks that the host's generator still makes exactly these.
+pub fn fixture_imgs() -> Vec<(&'static str, Img)> {
+    let dir = fixtures_dir();
+    let listed: Vec<String> = fixture_truth().into_iter().map(|(f, _)| f).collect();
+    let want: Vec<&str> = FIXTURES.iter().map(|&(_, file)| file).collect();
+    assert_eq!(listed, want, "truth.csv lists the fixture files");
+    FIXTURES
+        .iter()
+        .map(|&(name, file)| (name, read_png14(&dir.join(file))))
         .collect()
 }

@@ -1,11 +1,11 @@
 //! Noise model: Table 2 from Table 1 (paper Eqs. 11–14), Eq. 16's ADU figure, the NVD of
 //! Eq. 15, the three noise levels, and the statistics of the seeded noise field.
 
-use tirroi::core::sensor::expose_frame;
-use tirroi::core::sensor::noise::{
+use tirroi_core::sensor::expose_frame;
+use tirroi_core::sensor::noise::{
     ADC_GAIN_ADU_PER_V, BOLTZMANN_J_K, DEFAULT_FLICKER_CORRELATION_PX, NoiseRms,
 };
-use tirroi::core::sensor::{
+use tirroi_core::sensor::{
     BandRadiance, BolometerParams, DnMapping, NoiseField, NoiseLevel, NoiseSigmas, RmsReading,
 };
 

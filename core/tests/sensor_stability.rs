@@ -3,9 +3,9 @@
 
 use proptest::prelude::*;
 use std::sync::OnceLock;
-use tirroi::core::sensor::flux::{facet_flux_w_m2, view_factor_per_m2};
-use tirroi::core::sensor::planck::T_MAX_K;
-use tirroi::core::sensor::{
+use tirroi_core::sensor::flux::{facet_flux_w_m2, view_factor_per_m2};
+use tirroi_core::sensor::planck::T_MAX_K;
+use tirroi_core::sensor::{
     BandLut, BandRadiance, DnMapping, NoiseField, NoiseSigmas, SENSOR_AREA_M2, expose_frame,
 };
 

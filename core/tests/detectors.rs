@@ -4,13 +4,13 @@
 mod common;
 
 use common::*;
-use tirroi::core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH, FrameError};
-use tirroi::core::roi::adaptive::{self, Adaptive, AdaptiveScratch};
-use tirroi::core::roi::dog::{self, Dog, DogScratch};
-use tirroi::core::roi::otsu::{self, Otsu, OtsuScratch};
-use tirroi::core::roi::wge::{self, Wge, WgeScratch};
-use tirroi::core::roi::{RoiBuilder, Scratch};
-use tirroi::core::{BoxRule, DetectError, Detector, Frame, Method, Roi};
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH, FrameError};
+use tirroi_core::roi::adaptive::{self, Adaptive, AdaptiveScratch};
+use tirroi_core::roi::dog::{self, Dog, DogScratch};
+use tirroi_core::roi::otsu::{self, Otsu, OtsuScratch};
+use tirroi_core::roi::wge::{self, Wge, WgeScratch};
+use tirroi_core::roi::{RoiBuilder, Scratch};
+use tirroi_core::{BoxRule, DetectError, Detector, Frame, Method, Roi};
 
 const W: usize = FRAME_WIDTH;
 const H: usize = FRAME_HEIGHT;

@@ -3,8 +3,8 @@
 //! `scripts/reference/band_radiance.py` (mpmath, two independent quadratures), and the
 //! flat response against σT⁴/π.
 
-use tirroi::core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
-use tirroi::core::sensor::{BandLut, BandRadiance, CameraResponse, DnMapping};
+use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
+use tirroi_core::sensor::{BandLut, BandRadiance, CameraResponse, DnMapping};
 
 /// (T in K, L in W m⁻² sr⁻¹) from the reference table, parsed as f64 (the 30 digits
 /// round to the nearest f64, 1e-16 relative: far below every bound tested here).
