@@ -3,6 +3,10 @@
 //! prng.di.unimi.it), seeded by SplitMix64 as its authors recommend, and Gaussian pairs
 //! by the Box–Muller transform. 16 bytes of state, 32-bit operations only (native on a
 //! Cortex-M), the same stream on every target for a seed.
+//!
+//! It is also the one generator of the core's tests: `core/tests/common` draws its
+//! random test frames and masks from [`Xoshiro128pp::seed_from_u64`] and
+//! [`Xoshiro128pp::next_u32`] (no private copy of a generator there).
 
 /// xoshiro128++: period 2¹²⁸ − 1, passes BigCrush; 16 bytes.
 #[derive(Debug, Clone)]

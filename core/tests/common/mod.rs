@@ -1,7 +1,7 @@
-//! Shared helpers of the core's integration tests (std, no host): a seeded generator,
-//! the committed fixture frames, ASCII-art frames and masks, frame and mask generators,
-//! a spy that records a detector's mask, and brute-force references of every
-//! detector's documented semantics.
+//! Shared helpers of the core's integration tests (std, no host): a seeded generator
+//! over the core's own noise generator, the committed fixture frames, ASCII-art frames and
+//! masks, frame and mask generators, a spy that records a detector's mask, and
+//! brute-force references of every detector's documented semantics.
 //!
 //! The references are written from the module documentation only (never by calling a
 //! detector's internals): they are deliberately slow and obvious.
@@ -17,29 +17,30 @@ use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
+use tirroi_core::sensor::rng::Xoshiro128pp;
 use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Roi};
 
 // ---------------------------------------------------------------------------------
 // Seeded generator
 // ---------------------------------------------------------------------------------
 
-/// splitmix64: tiny, seeded, good enough for test data.
+/// Test data from the core's own noise generator ([`Xoshiro128pp`], the one the
+/// camera model draws its noise from, seeded by SplitMix64): one generator for the
+/// whole core, the same stream on every target for a seed. 64-bit draws are two 32-bit
+/// outputs, high word first.
 #[derive(Debug, Clone)]
-pub struct Rng(u64);
+pub struct Rng(Xoshiro128pp);
 
 impl Rng {
     /// A generator for `seed`.
     pub fn new(seed: u64) -> Self {
-        Rng(seed ^ 0x5DEE_CE66_D1CE_4E5B)
+        Rng(Xoshiro128pp::seed_from_u64(seed))
     }
 
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        let hi = u64::from(self.0.next_u32());
+        (hi << 32) | u64::from(self.0.next_u32())
     }
 
     /// Uniform in `0..n` (`n > 0`).
