@@ -25,10 +25,10 @@
 //!
 //! | detector | scratch type | bytes | budget |
 //! |---|---|---|---|
-//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] = 15 208 | 16 KiB |
-//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 11 568 | 16 KiB |
-//! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 344 | 16 KiB |
-//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 288 | 96 KiB |
+//! | Otsu | [`roi::otsu::OtsuScratch`] | [`roi::otsu::SCRATCH_BYTES`] = 15 216 | 16 KiB |
+//! | adaptive | [`roi::adaptive::AdaptiveScratch`] | [`roi::adaptive::SCRATCH_BYTES`] = 11 576 | 16 KiB |
+//! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 352 | 16 KiB |
+//! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 296 | 96 KiB |
 //! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 456 | 32 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in the README.

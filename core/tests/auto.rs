@@ -31,10 +31,18 @@ fn noise(x: usize, y: usize, amp: i32) -> i32 {
 #[test]
 fn scratch_fits_32_kib_and_is_static() {
     static SCRATCH: AutoScratch = AutoScratch::new();
+    // The budget of lib.rs's memory table, at compile time and as `Method` reports it.
     const { assert!(auto::SCRATCH_BYTES <= 32 * 1024) };
-    assert_eq!(auto::SCRATCH_BYTES, size_of::<AutoScratch>());
-    assert_eq!(Method::Auto.scratch_bytes(), auto::SCRATCH_BYTES);
-    assert_eq!(size_of_val(&SCRATCH), auto::SCRATCH_BYTES);
+    assert!(Method::Auto.scratch_bytes() <= 32 * 1024);
+    assert!(size_of_val(&SCRATCH) <= 32 * 1024);
+    // The exact figure of lib.rs's table, the README and `tirroi memory` (x86-64; 32-bit
+    // targets save a few bytes of `usize` fields).
+    #[cfg(target_pointer_width = "64")]
+    {
+        assert_eq!(auto::SCRATCH_BYTES, 25_456);
+        assert_eq!(Method::Auto.scratch_bytes(), 25_456);
+        assert_eq!(size_of_val(&SCRATCH), 25_456);
+    }
     assert_eq!(Method::from_name("auto"), Some(Method::Auto));
 }
 
