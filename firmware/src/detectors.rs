@@ -1,11 +1,9 @@
-//! Every detector of the core with its scratch memory, behind one call per method.
+//! Every detector of the core with its scratch memory, behind one call per method: the
+//! core's registry bank ([`tirroi_core::roi::Detectors`]) with default parameters.
 
-use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
-use tirroi_core::roi::auto::{Auto, AutoScratch};
-use tirroi_core::roi::dog::{Dog, DogScratch};
-use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
-use tirroi_core::roi::wge::{Wge, WgeScratch};
-use tirroi_core::{DetectError, Detection, Detector, Frame, Method, Roi};
+use tirroi_core::roi::auto::Auto;
+use tirroi_core::roi::{self, Params};
+use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
 
 /// The methods the demo runs on every frame, in the core's order.
 pub const DEMO_METHODS: &[Method] = &Method::ALL;
@@ -13,23 +11,15 @@ pub const DEMO_METHODS: &[Method] = &Method::ALL;
 /// The detectors with their default parameters (what `tirroi detect` runs on the host,
 /// so the boxes can be compared bit for bit) and each one's scratch memory.
 pub struct Detectors {
-    otsu: OtsuScratch,
-    adaptive: AdaptiveScratch,
-    wge: WgeScratch,
-    dog: DogScratch,
-    auto: AutoScratch,
+    bank: roi::Detectors,
 }
 
 impl Detectors {
     /// Fresh scratch for every detector (a `const fn`: the whole struct can be a
-    /// `static`, in `.bss`).
+    /// `static`).
     pub const fn new() -> Self {
         Detectors {
-            otsu: OtsuScratch::new(),
-            adaptive: AdaptiveScratch::new(),
-            wge: WgeScratch::new(),
-            dog: DogScratch::new(),
-            auto: AutoScratch::new(),
+            bank: roi::Detectors::new(),
         }
     }
 
@@ -43,13 +33,7 @@ impl Detectors {
     /// tests).
     #[inline(never)]
     pub fn run(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        match method {
-            Method::Otsu => Otsu::default().detect(frame, &mut self.otsu),
-            Method::Adaptive => Adaptive::default().detect(frame, &mut self.adaptive),
-            Method::Wge => Wge::default().detect(frame, &mut self.wge),
-            Method::Dog => Dog::default().detect(frame, &mut self.dog),
-            Method::Auto => Auto::default().detect(frame, &mut self.auto),
-        }
+        self.bank.detect(&method.default_params(), frame)
     }
 }
 
@@ -63,9 +47,8 @@ impl Detectors {
     /// [`DetectError`] when the default parameters are refused (never).
     #[inline(never)]
     pub fn track(&mut self, prior: Roi, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        Auto::default()
-            .with_prior(Some(prior))
-            .detect(frame, &mut self.auto)
+        let params = Params::Auto(Auto::default().with_prior(Some(prior)));
+        self.bank.detect(&params, frame)
     }
 }
 

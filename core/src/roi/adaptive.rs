@@ -8,7 +8,7 @@
 //! `block` rows around the current row, updated by one row in and one row out, and
 //! their prefix sums along the row: scratch memory is O(width), never O(pixels).
 
-use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detector, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
 
 /// Largest block side accepted, in pixels (the whole height of a reference frame).
@@ -58,14 +58,7 @@ pub const SCRATCH_BYTES: usize = core::mem::size_of::<AdaptiveScratch>();
 impl AdaptiveScratch {
     /// Fresh scratch memory (a `const fn`, so it can be a `static`).
     pub const fn new() -> Self {
-        Scratch {
-            work: AdaptiveWork {
-                column_sum: [0; FRAME_WIDTH],
-                prefix: [0; FRAME_WIDTH + 1],
-                mask: [false; FRAME_WIDTH],
-            },
-            roi: RoiBuilder::new(),
-        }
+        Scratch::from_work(<Adaptive as Detector>::WORK)
     }
 }
 
@@ -75,9 +68,26 @@ impl Default for AdaptiveScratch {
     }
 }
 
+/// The parameters as `name=value` pairs separated by spaces (as in tuning reports
+/// and tuned sets).
+impl core::fmt::Display for Adaptive {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "block={} offset_dn={} box={}",
+            self.block, self.offset_dn, self.box_rule
+        )
+    }
+}
+
 impl Detector for Adaptive {
     type Work = AdaptiveWork;
     const NAME: &'static str = "adaptive";
+    const WORK: AdaptiveWork = AdaptiveWork {
+        column_sum: [0; FRAME_WIDTH],
+        prefix: [0; FRAME_WIDTH + 1],
+        mask: [false; FRAME_WIDTH],
+    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if self.block < 3 || self.block > MAX_BLOCK || self.block % 2 == 0 {
@@ -91,6 +101,10 @@ impl Detector for Adaptive {
 
     fn box_rule(&self) -> BoxRule {
         self.box_rule
+    }
+
+    fn set_box_rule(&mut self, rule: BoxRule) {
+        self.box_rule = rule;
     }
 
     /// Foreground: `DN > block mean + offset_dn`. Threshold: `offset_dn` (as `u32`,

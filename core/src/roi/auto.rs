@@ -55,7 +55,7 @@
 //! time).
 
 use super::plane::{BLOCK, Window};
-use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
 
 /// Width of the block-mean plane, in cells (82 for 328 pixels).
@@ -190,20 +190,7 @@ const _: () = assert!(SCRATCH_BYTES <= 32 * 1024, "auto's scratch exceeds 32 KiB
 impl AutoScratch {
     /// Fresh scratch memory (a `const fn`, so it can be a `static`).
     pub const fn new() -> Self {
-        Scratch {
-            work: AutoWork {
-                step: [0; GRID],
-                label: [0; GRID],
-                parent: [0; 256],
-                comps: [NO_COMPONENT; MAX_COMPONENTS + 1],
-                steps: [0; FRAME_WIDTH],
-                col_sat: [0; FRAME_WIDTH],
-                row_sat: [0; FRAME_HEIGHT],
-                hist: [0; NOISE_BINS + 1],
-                mask: [false; FRAME_WIDTH],
-            },
-            roi: RoiBuilder::new(),
-        }
+        Scratch::from_work(<Auto as Detector>::WORK)
     }
 }
 
@@ -1025,9 +1012,32 @@ fn detection(f: Found) -> Detection {
     }
 }
 
+/// The parameters as `name=value` pairs separated by spaces (as in tuning reports
+/// and tuned sets).
+impl core::fmt::Display for Auto {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "coarse_k={} fine_k={} margin_px={}",
+            self.coarse_k, self.fine_k, self.margin_px
+        )
+    }
+}
+
 impl Detector for Auto {
     type Work = AutoWork;
     const NAME: &'static str = "auto";
+    const WORK: AutoWork = AutoWork {
+        step: [0; GRID],
+        label: [0; GRID],
+        parent: [0; 256],
+        comps: [NO_COMPONENT; MAX_COMPONENTS + 1],
+        steps: [0; FRAME_WIDTH],
+        col_sat: [0; FRAME_WIDTH],
+        row_sat: [0; FRAME_HEIGHT],
+        hist: [0; NOISE_BINS + 1],
+        mask: [false; FRAME_WIDTH],
+    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if !(1..=1000).contains(&self.coarse_k) {

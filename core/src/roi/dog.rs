@@ -25,7 +25,7 @@
 //! list and the mask-to-box state: see [`SCRATCH_BYTES`].
 
 use super::plane::{BLOCK, Window, block_means};
-use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detector, Scratch};
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
 
 /// Block side of the downsampling, in pixels.
@@ -134,22 +134,7 @@ pub const SCRATCH_BYTES: usize = core::mem::size_of::<DogScratch>();
 impl DogScratch {
     /// Fresh scratch memory (a `const fn`, so it can be a `static`).
     pub const fn new() -> Self {
-        Scratch {
-            work: DogWork {
-                base: [0; PLANE],
-                half: [0; HALF_PLANE],
-                half_sigma: 0.0,
-                tmp: [0; PLANE],
-                ring: [[0; PLANE]; 4],
-                row_sum: [0; PLANE_WIDTH],
-                pad: [0; PLANE_WIDTH + KERNEL_CAPACITY],
-                kernel: [0; 2 * MAX_RADIUS + 1],
-                blobs: [NO_BLOB; MAX_BLOBS],
-                blob_count: 0,
-                mask: [false; FRAME_WIDTH],
-            },
-            roi: RoiBuilder::new(),
-        }
+        Scratch::from_work(<Dog as Detector>::WORK)
     }
 
     /// The blobs of the last [`Detector::detect`] call, strongest not first.
@@ -247,9 +232,34 @@ fn blur_rows_transposed(src: &[u16], dst: &mut [u16], w: usize, kernel: &[i16], 
     }
 }
 
+/// The parameters as `name=value` pairs separated by spaces (as in tuning reports
+/// and tuned sets).
+impl core::fmt::Display for Dog {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "sigma0_px={} sigma_ratio={} levels={} min_response_dn={} box={}",
+            self.sigma0_px, self.sigma_ratio, self.levels, self.min_response_dn, self.box_rule
+        )
+    }
+}
+
 impl Detector for Dog {
     type Work = DogWork;
     const NAME: &'static str = "dog";
+    const WORK: DogWork = DogWork {
+        base: [0; PLANE],
+        half: [0; HALF_PLANE],
+        half_sigma: 0.0,
+        tmp: [0; PLANE],
+        ring: [[0; PLANE]; 4],
+        row_sum: [0; PLANE_WIDTH],
+        pad: [0; PLANE_WIDTH + KERNEL_CAPACITY],
+        kernel: [0; 2 * MAX_RADIUS + 1],
+        blobs: [NO_BLOB; MAX_BLOBS],
+        blob_count: 0,
+        mask: [false; FRAME_WIDTH],
+    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if !(self.sigma0_px.is_finite() && self.sigma0_px >= 1.0) {
@@ -283,6 +293,10 @@ impl Detector for Dog {
 
     fn box_rule(&self) -> BoxRule {
         self.box_rule
+    }
+
+    fn set_box_rule(&mut self, rule: BoxRule) {
+        self.box_rule = rule;
     }
 
     /// Foreground: the union of the blob squares. Threshold: `min_response_dn`.

@@ -19,7 +19,7 @@
 //! with a single DN value has no split: its threshold is that DN and no pixel is
 //! foreground.
 
-use super::{BoxRule, DetectError, Detector, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detector, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
 
 /// Coarse histogram bins (a bin spans `2^(bits − 7)` DN for bit depths above 7).
@@ -65,15 +65,7 @@ pub const SCRATCH_BYTES: usize = core::mem::size_of::<OtsuScratch>();
 impl OtsuScratch {
     /// Fresh scratch memory (a `const fn`, so it can be a `static`).
     pub const fn new() -> Self {
-        Scratch {
-            work: OtsuWork {
-                coarse: [[0; COARSE_BINS]; LANES],
-                fine: [[0; FINE_SLOTS]; 2],
-                slot: [NOT_REFINED; COARSE_BINS],
-                mask: [false; FRAME_WIDTH],
-            },
-            roi: RoiBuilder::new(),
-        }
+        Scratch::from_work(<Otsu as Detector>::WORK)
     }
 }
 
@@ -355,9 +347,23 @@ fn bin_may_beat(
     bound.cmp(&best.score).is_ge()
 }
 
+/// The parameters as `name=value` pairs separated by spaces (as in tuning reports
+/// and tuned sets).
+impl core::fmt::Display for Otsu {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "box={}", self.box_rule)
+    }
+}
+
 impl Detector for Otsu {
     type Work = OtsuWork;
     const NAME: &'static str = "otsu";
+    const WORK: OtsuWork = OtsuWork {
+        coarse: [[0; COARSE_BINS]; LANES],
+        fine: [[0; FINE_SLOTS]; 2],
+        slot: [NOT_REFINED; COARSE_BINS],
+        mask: [false; FRAME_WIDTH],
+    };
 
     fn validate(&self) -> Result<(), DetectError> {
         Ok(())
@@ -365,6 +371,10 @@ impl Detector for Otsu {
 
     fn box_rule(&self) -> BoxRule {
         self.box_rule
+    }
+
+    fn set_box_rule(&mut self, rule: BoxRule) {
+        self.box_rule = rule;
     }
 
     /// Foreground: `DN > t`. Threshold: the smallest `t` maximising the between-class

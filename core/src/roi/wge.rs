@@ -16,7 +16,7 @@
 //! gradient image is stored; each pass recomputes the gradients of one row from three
 //! frame rows.
 
-use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
+use super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
 use crate::frame::{FRAME_WIDTH, Frame};
 
 /// Counters of the gradient histogram: [`COARSE_LANES`] interleaved copies of
@@ -70,14 +70,7 @@ pub const SCRATCH_BYTES: usize = core::mem::size_of::<WgeScratch>();
 impl WgeScratch {
     /// Fresh scratch memory (a `const fn`, so it can be a `static`).
     pub const fn new() -> Self {
-        Scratch {
-            work: WgeWork {
-                hist: [0; COARSE_BINS],
-                gradient: [0; FRAME_WIDTH],
-                mask: [false; FRAME_WIDTH],
-            },
-            roi: RoiBuilder::new(),
-        }
+        Scratch::from_work(<Wge as Detector>::WORK)
     }
 }
 
@@ -338,9 +331,26 @@ impl Wge {
     }
 }
 
+/// The parameters as `name=value` pairs separated by spaces (as in tuning reports
+/// and tuned sets).
+impl core::fmt::Display for Wge {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "drop_fraction={} min_gradient={} box={}",
+            self.drop_fraction, self.min_gradient, self.box_rule
+        )
+    }
+}
+
 impl Detector for Wge {
     type Work = WgeWork;
     const NAME: &'static str = "wge";
+    const WORK: WgeWork = WgeWork {
+        hist: [0; COARSE_BINS],
+        gradient: [0; FRAME_WIDTH],
+        mask: [false; FRAME_WIDTH],
+    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if !(0.0..=1.0).contains(&self.drop_fraction) {
@@ -354,6 +364,10 @@ impl Detector for Wge {
 
     fn box_rule(&self) -> BoxRule {
         self.box_rule
+    }
+
+    fn set_box_rule(&mut self, rule: BoxRule) {
+        self.box_rule = rule;
     }
 
     /// Foreground: interior pixels with Prewitt L1 gradient `≥ threshold`. Threshold:

@@ -1,0 +1,213 @@
+//! The one registry of detectors: [`detector_registry!`](crate::detector_registry)
+//! turns one line per detector into everything that dispatches on a method.
+//!
+//! From the entries `Variant(field) => path::Detector` it declares:
+//!
+//! - a method enum (`Method`): `ALL` in registry order, `name` (the detector's
+//!   [`Detector::NAME`]), `from_name`, `scratch_bytes` (the size of its [`Scratch`]),
+//!   `default_params`, `Display`;
+//! - a parameter enum (`Params`), one variant per detector holding its parameter
+//!   struct: `method`, `box_rule`, `set_box_rule`, `validate`, `Display` (the
+//!   detector's `name=value` pairs);
+//! - a bank (`Detectors`) holding every detector's scratch memory, built by a
+//!   `const fn` (so it can be a `static` on flight hardware), with `detect(&Params,
+//!   &Frame)`.
+//!
+//! The core's five detectors are registered in [`super`] as [`super::Method`],
+//! [`super::Params`] and [`super::Detectors`]; the host CLI, evaluation, tuning,
+//! plots, the firmware and the tests all dispatch through them. Adding a detector is
+//! its module (parameters implementing [`Detector`], `Default`, `Copy`, `Display`) plus
+//! one line in that registry; the test `tests/registry.rs` of the core declares a
+//! registry with a toy detector to show it.
+//!
+//! [`Detector`]: super::Detector
+//! [`Detector::NAME`]: super::Detector::NAME
+//! [`Scratch`]: super::Scratch
+
+/// Declares a detector registry: a method enum, a parameter enum and a scratch bank
+/// from one entry per detector (see the [module documentation](crate::roi::registry)).
+///
+/// ```
+/// use tirroi_core::roi::{adaptive::Adaptive, otsu::Otsu};
+/// use tirroi_core::{Detector, Frame};
+///
+/// tirroi_core::detector_registry! {
+///     /// Two of the core's detectors.
+///     pub enum Pick;
+///     /// Their parameters.
+///     pub enum PickParams;
+///     /// Their scratch memory.
+///     pub struct PickBank;
+///     /// Otsu's threshold.
+///     Otsu(otsu) => Otsu,
+///     /// The local-mean threshold.
+///     Adaptive(adaptive) => Adaptive,
+/// }
+///
+/// assert_eq!(Pick::ALL, [Pick::Otsu, Pick::Adaptive]);
+/// assert_eq!(Pick::from_name("adaptive"), Some(Pick::Adaptive));
+/// let pixels = [0u16; 16 * 8];
+/// let frame = Frame::new(&pixels, 16, 8, 14).unwrap();
+/// let mut bank = Box::new(PickBank::new());
+/// let found = bank.detect(&Pick::Otsu.default_params(), &frame).unwrap();
+/// assert_eq!(found.roi, None);
+/// ```
+#[macro_export]
+macro_rules! detector_registry {
+    (
+        $(#[$method_meta:meta])*
+        $vis:vis enum $Method:ident;
+        $(#[$params_meta:meta])*
+        $params_vis:vis enum $Params:ident;
+        $(#[$bank_meta:meta])*
+        $bank_vis:vis struct $Bank:ident;
+        $(
+            $(#[$entry_meta:meta])*
+            $Variant:ident($field:ident) => $Det:ty
+        ),+ $(,)?
+    ) => {
+        $(#[$method_meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        $vis enum $Method {
+            $(
+                $(#[$entry_meta])*
+                $Variant,
+            )+
+        }
+
+        impl $Method {
+            /// Every registered method, in registry order.
+            pub const ALL: [$Method; [$(stringify!($Variant)),+].len()] =
+                [$($Method::$Variant),+];
+
+            /// The lower-case name used on the command line (`Detector::NAME`).
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $($Method::$Variant => <$Det as $crate::roi::Detector>::NAME,)+
+                }
+            }
+
+            /// The method of a lower-case name, `None` for any other string.
+            pub fn from_name(name: &str) -> ::core::option::Option<$Method> {
+                $Method::ALL.into_iter().find(|m| m.name() == name)
+            }
+
+            /// Bytes of scratch memory the method needs beyond the input frame (its
+            /// `Scratch`), on this target.
+            pub const fn scratch_bytes(self) -> usize {
+                match self {
+                    $($Method::$Variant => ::core::mem::size_of::<
+                        $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work>,
+                    >(),)+
+                }
+            }
+
+            /// The detector's default parameters.
+            pub fn default_params(self) -> $Params {
+                match self {
+                    $($Method::$Variant => $Params::$Variant(<$Det as ::core::default::Default>::default()),)+
+                }
+            }
+        }
+
+        impl ::core::fmt::Display for $Method {
+            fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        $(#[$params_meta])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        $params_vis enum $Params {
+            $(
+                $(#[$entry_meta])*
+                $Variant($Det),
+            )+
+        }
+
+        impl $Params {
+            /// The method these parameters belong to.
+            pub const fn method(&self) -> $Method {
+                match self {
+                    $($Params::$Variant(_) => $Method::$Variant,)+
+                }
+            }
+
+            /// The mask-to-box rule (`Detector::box_rule`).
+            pub fn box_rule(&self) -> $crate::roi::BoxRule {
+                match self {
+                    $($Params::$Variant(p) => $crate::roi::Detector::box_rule(p),)+
+                }
+            }
+
+            /// Sets the mask-to-box rule (`Detector::set_box_rule`; a detector
+            /// without one ignores it).
+            pub fn set_box_rule(&mut self, rule: $crate::roi::BoxRule) {
+                match self {
+                    $($Params::$Variant(p) => $crate::roi::Detector::set_box_rule(p, rule),)+
+                }
+            }
+
+            /// Checks the parameters against their documented bounds.
+            ///
+            /// # Errors
+            /// `DetectError::InvalidParameter` naming the first field out of bounds.
+            pub fn validate(&self) -> ::core::result::Result<(), $crate::roi::DetectError> {
+                match self {
+                    $($Params::$Variant(p) => $crate::roi::Detector::validate(p),)+
+                }
+            }
+        }
+
+        impl ::core::fmt::Display for $Params {
+            /// The parameters as `name=value` pairs separated by spaces.
+            fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                match self {
+                    $($Params::$Variant(p) => ::core::fmt::Display::fmt(p, f),)+
+                }
+            }
+        }
+
+        $(#[$bank_meta])*
+        #[derive(Clone)]
+        $bank_vis struct $Bank {
+            $(
+                $field: $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work>,
+            )+
+        }
+
+        impl $Bank {
+            /// Fresh scratch for every detector (a `const fn`, so the bank can be a
+            /// `static`).
+            pub const fn new() -> Self {
+                $Bank {
+                    $(
+                        $field: $crate::roi::Scratch::from_work(
+                            <$Det as $crate::roi::Detector>::WORK,
+                        ),
+                    )+
+                }
+            }
+
+            /// Runs the detector of `params` on `frame` in its scratch.
+            ///
+            /// # Errors
+            /// `DetectError` when the parameters are out of bounds.
+            pub fn detect(
+                &mut self,
+                params: &$Params,
+                frame: &$crate::frame::Frame<'_>,
+            ) -> ::core::result::Result<$crate::roi::Detection, $crate::roi::DetectError> {
+                match params {
+                    $($Params::$Variant(p) => $crate::roi::Detector::detect(p, frame, &mut self.$field),)+
+                }
+            }
+        }
+
+        impl ::core::default::Default for $Bank {
+            fn default() -> Self {
+                Self::new()
+            }
+        }
+    };
+}
