@@ -33,7 +33,7 @@ impl Detectors {
     /// tests).
     #[inline(never)]
     pub fn run(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        self.bank.detect(&method.default_params(), frame)
+        self.bank.detect_default(method, frame)
     }
 }
 

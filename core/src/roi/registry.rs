@@ -103,6 +103,7 @@ macro_rules! detector_registry {
             }
 
             /// The detector's default parameters.
+            #[inline]
             pub fn default_params(self) -> $Params {
                 match self {
                     $($Method::$Variant => $Params::$Variant(<$Det as ::core::default::Default>::default()),)+
@@ -127,6 +128,7 @@ macro_rules! detector_registry {
 
         impl $Params {
             /// The method these parameters belong to.
+            #[inline]
             pub const fn method(&self) -> $Method {
                 match self {
                     $($Params::$Variant(_) => $Method::$Variant,)+
@@ -134,6 +136,7 @@ macro_rules! detector_registry {
             }
 
             /// The mask-to-box rule (`Detector::box_rule`).
+            #[inline]
             pub fn box_rule(&self) -> $crate::roi::BoxRule {
                 match self {
                     $($Params::$Variant(p) => $crate::roi::Detector::box_rule(p),)+
@@ -142,6 +145,7 @@ macro_rules! detector_registry {
 
             /// Sets the mask-to-box rule (`Detector::set_box_rule`; a detector
             /// without one ignores it).
+            #[inline]
             pub fn set_box_rule(&mut self, rule: $crate::roi::BoxRule) {
                 match self {
                     $($Params::$Variant(p) => $crate::roi::Detector::set_box_rule(p, rule),)+
@@ -152,6 +156,7 @@ macro_rules! detector_registry {
             ///
             /// # Errors
             /// `DetectError::InvalidParameter` naming the first field out of bounds.
+            #[inline]
             pub fn validate(&self) -> ::core::result::Result<(), $crate::roi::DetectError> {
                 match self {
                     $($Params::$Variant(p) => $crate::roi::Detector::validate(p),)+
@@ -193,6 +198,7 @@ macro_rules! detector_registry {
             ///
             /// # Errors
             /// `DetectError` when the parameters are out of bounds.
+            #[inline]
             pub fn detect(
                 &mut self,
                 params: &$Params,
@@ -200,6 +206,30 @@ macro_rules! detector_registry {
             ) -> ::core::result::Result<$crate::roi::Detection, $crate::roi::DetectError> {
                 match params {
                     $($Params::$Variant(p) => $crate::roi::Detector::detect(p, frame, &mut self.$field),)+
+                }
+            }
+        }
+
+        impl $Bank {
+            /// Runs `method` with its default parameters on `frame` (the parameters are
+            /// constants here, so the compiler specialises each detector for them, as
+            /// flight code calling it directly would be).
+            ///
+            /// # Errors
+            /// `DetectError` when the default parameters are out of bounds (never for
+            /// the core's detectors, by their tests).
+            #[inline(always)]
+            pub fn detect_default(
+                &mut self,
+                method: $Method,
+                frame: &$crate::frame::Frame<'_>,
+            ) -> ::core::result::Result<$crate::roi::Detection, $crate::roi::DetectError> {
+                match method {
+                    $($Method::$Variant => $crate::roi::Detector::detect(
+                        &<$Det as ::core::default::Default>::default(),
+                        frame,
+                        &mut self.$field,
+                    ),)+
                 }
             }
         }
