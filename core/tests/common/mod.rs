@@ -795,6 +795,7 @@ pub struct Spy<D> {
 impl<D: Detector> Detector for Spy<D> {
     type Work = D::Work;
     const NAME: &'static str = "spy";
+    const WORK: D::Work = D::WORK;
 
     fn validate(&self) -> Result<(), DetectError> {
         self.inner.validate()
