@@ -1,4 +1,4 @@
-//! `tirroi_host::tune` and `tirroi tune`: the tune/test split is a stable, disjoint
+//! `tirroi_host::eval::tune` and `tirroi tune`: the tune/test split is a stable, disjoint
 //! ~30 % partition; the search scores its whole grid (defaults included) and never does
 //! worse than the defaults on the frames it tunes on; bad arguments exit with code 2.
 
@@ -8,9 +8,9 @@ use std::path::Path;
 
 use cli_common::run;
 use tirroi_core::{BoxRule, Method, Roi};
-use tirroi_host::eval::{TruthRow, read_truth};
-use tirroi_host::image_io::{FrameBuf, write_png16};
-use tirroi_host::tune::{self, Params, SearchOptions, Split};
+use tirroi_host::eval::scoring::{TruthRow, read_truth};
+use tirroi_host::eval::tune::{self, Params, SearchOptions, Split};
+use tirroi_host::imaging::image_io::{FrameBuf, write_png16};
 
 fn row(file: &str) -> TruthRow {
     TruthRow {

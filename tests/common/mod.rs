@@ -890,10 +890,10 @@ pub const RULES: [BoxRule; 2] = [BoxRule::AllForeground, BoxRule::LargestCompone
 
 /// The host's procedural fixture frames as test images, with their names.
 pub fn fixture_imgs() -> Vec<(&'static str, Img)> {
-    tirroi::host::fixture::standard_set()
+    tirroi::host::imaging::fixture::standard_set()
         .into_iter()
         .map(|(name, spec)| {
-            let frame = tirroi::host::fixture::render(&spec).frame;
+            let frame = tirroi::host::imaging::fixture::render(&spec).frame;
             let img = Img {
                 px: frame.pixels,
                 w: frame.width,

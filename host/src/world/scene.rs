@@ -32,8 +32,8 @@ use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::sensor::DetectionScale;
 use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
 
-use crate::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
-use crate::target::MaterialCase;
+use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
+use crate::world::spacecraft::MaterialCase;
 
 /// The camera of Table 4 (Hayabusa2 TIR) and its read-out.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -275,7 +275,7 @@ impl<T: Copy> OneOrMany<T> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EarthSource {
-    /// The built-in synthetic daily field ([`crate::earth::OlrGrid::builtin`]).
+    /// The built-in synthetic daily field ([`crate::world::earth::OlrGrid::builtin`]).
     Builtin,
     /// A CERES SYN1deg NetCDF file (`path`, `variable`, `time_index`); needs the
     /// `netcdf` cargo feature.
@@ -643,17 +643,17 @@ pub const PRESETS: [(&str, &str, &str); 3] = [
     (
         "paper",
         "Section 4.1: 12 000 cube+cylinder images, radiometry (3 material cases) and detection (Scales 1-3), close 15-50 m and far 340-440 m, sunlit and eclipse",
-        include_str!("../presets/paper.toml"),
+        include_str!("../../presets/paper.toml"),
     ),
     (
         "tango",
         "Section 5: 1 000 radiometry images of a Tango-like satellite at close range, sunlit and eclipse",
-        include_str!("../presets/tango.toml"),
+        include_str!("../../presets/tango.toml"),
     ),
     (
         "quick",
         "24 images across every scene kind (both modes, all material cases and scales, both targets) for a first look",
-        include_str!("../presets/quick.toml"),
+        include_str!("../../presets/quick.toml"),
     ),
 ];
 

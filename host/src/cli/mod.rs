@@ -8,11 +8,17 @@ use clap::{Parser, Subcommand};
 use serde::Serialize;
 use tirroi_core::{BoxRule, Method};
 
-use crate::image_io::read_frame;
-use crate::run::DetectorBank;
-use crate::scene::{self, SceneFile};
-use crate::sensor_view::{self, SensorRequest};
-use crate::{dataset, eval, figure, fixture, paper, progress};
+use crate::cli::sensor::{self as sensor_view, SensorRequest};
+use crate::eval::bank::DetectorBank;
+use crate::eval::scoring;
+use crate::imaging::image_io::read_frame;
+use crate::imaging::{fixture, overlay};
+use crate::report::paper;
+use crate::world::scene::{self, SceneFile};
+use crate::{dataset, progress};
+
+/// `tirroi sensor`: the thermal camera model of `tirroi_core::sensor` as tables or JSON.
+pub mod sensor;
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
@@ -122,7 +128,7 @@ pub enum Command {
         /// it over); sequence (frames in file-name order, each frame's prior is auto's
         /// box on the previous one; one thread).
         #[arg(long, default_value = "off", value_parser = parse_track)]
-        track: eval::Track,
+        track: scoring::Track,
     },
     /// Reproduce the paper's results: render (or reuse) the datasets, score every
     /// detector, print Tables 6, 7 and 8 beside the paper's, and write the figures.
@@ -152,7 +158,7 @@ pub enum Command {
     /// frames, by a hash of the file name), then checked on the test part. Markdown on
     /// stdout; every trial in --out/trials.csv. Bad input: one line
     /// `tirroi: error: ...`, exit code 2.
-    Tune(crate::tune::TuneArgs),
+    Tune(crate::eval::tune::TuneArgs),
 }
 
 /// The options of `tirroi render`.
@@ -161,7 +167,7 @@ pub struct RenderArgs {
     /// A built-in scene set: paper, tango or quick.
     #[arg(long, conflicts_with = "config", required_unless_present_any = ["config", "list_presets"])]
     pub preset: Option<String>,
-    /// A TOML scene/dataset file (format: the module docs of `tirroi_host::scene`, or
+    /// A TOML scene/dataset file (format: the module docs of `tirroi_host::world::scene`, or
     /// `--print-config` of a preset).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -280,11 +286,11 @@ fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
     }
 }
 
-fn parse_track(s: &str) -> Result<eval::Track, String> {
+fn parse_track(s: &str) -> Result<scoring::Track, String> {
     match s {
-        "off" => Ok(eval::Track::Off),
-        "jitter" => Ok(eval::Track::Jitter),
-        "sequence" => Ok(eval::Track::Sequence),
+        "off" => Ok(scoring::Track::Off),
+        "jitter" => Ok(scoring::Track::Jitter),
+        "sequence" => Ok(scoring::Track::Sequence),
         _ => Err(format!(
             "unknown tracking mode `{s}`; expected off, jitter or sequence"
         )),
@@ -352,7 +358,7 @@ pub fn main() -> ExitCode {
             out,
             track,
         } => {
-            let options = eval::EvalOptions {
+            let options = scoring::EvalOptions {
                 methods: method.0,
                 repeat: repeat as usize,
                 box_rule: Some(box_rule),
@@ -381,7 +387,7 @@ pub fn main() -> ExitCode {
             };
             exit_code(run_paper(&options))
         }
-        Command::Tune(args) => exit_code(crate::tune::run(&args)),
+        Command::Tune(args) => exit_code(crate::eval::tune::run(&args)),
         Command::Render(args) => exit_code(render_dataset(&args)),
     }
 }
@@ -400,21 +406,21 @@ fn exit_code(result: Result<(), String>) -> ExitCode {
 fn run_eval(
     images: &std::path::Path,
     truth: Option<&std::path::Path>,
-    options: &eval::EvalOptions,
+    options: &scoring::EvalOptions,
     out: Option<&std::path::Path>,
 ) -> Result<(), String> {
     let truth = truth.map_or_else(|| images.join("truth.csv"), std::path::Path::to_path_buf);
-    let rows = eval::read_truth(&truth).map_err(|e| e.to_string())?;
+    let rows = scoring::read_truth(&truth).map_err(|e| e.to_string())?;
     let bar = progress::bar(rows.len(), "frames");
-    let scores = eval::score(images, &rows, options, &DetectorBank::default, &|| {
+    let scores = scoring::score(images, &rows, options, &DetectorBank::default, &|| {
         bar.inc(1)
     })
     .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
-    let stats = eval::summarise(&scores);
-    print!("{}", eval::markdown(&stats));
+    let stats = scoring::summarise(&scores);
+    print!("{}", scoring::markdown(&stats));
     if let Some(out) = out {
-        eval::write_reports(out, &scores, &stats).map_err(|e| e.to_string())?;
+        scoring::write_reports(out, &scores, &stats).map_err(|e| e.to_string())?;
         println!(
             "\nwrote scores.csv, summary.csv and summary.json to {}",
             out.display()
@@ -648,8 +654,8 @@ fn demo(repeat: usize, figures: Option<&std::path::Path>) -> ExitCode {
             eprintln!("tirroi: error: fixture {name} does not fit the core");
             return ExitCode::from(EXIT_BAD_INPUT);
         };
-        let mut drawn = vec![(fx.truth, figure::TRUTH_COLOUR)];
-        for (method, colour) in Method::ALL.into_iter().zip(figure::METHOD_COLOURS) {
+        let mut drawn = vec![(fx.truth, overlay::TRUTH_COLOUR)];
+        for (method, colour) in Method::ALL.into_iter().zip(overlay::METHOD_COLOURS) {
             let mut cells = Vec::new();
             let mut time_us = 0.0;
             for rule in [BoxRule::AllForeground, BoxRule::LargestComponent] {
@@ -680,8 +686,8 @@ fn demo(repeat: usize, figures: Option<&std::path::Path>) -> ExitCode {
             );
         }
         if let Some(dir) = figures {
-            let img = figure::frame_with_boxes(&fx.frame, &drawn, 1);
-            if let Err(e) = figure::save(&img, &dir.join(format!("demo-{name}.png"))) {
+            let img = overlay::frame_with_boxes(&fx.frame, &drawn, 1);
+            if let Err(e) = overlay::save(&img, &dir.join(format!("demo-{name}.png"))) {
                 eprintln!("tirroi: error: {e}");
                 return ExitCode::from(EXIT_BAD_INPUT);
             }
@@ -705,7 +711,8 @@ fn write_fixtures(out: &std::path::Path) -> Result<(), String> {
     for (name, spec) in fixture::standard_set() {
         let fx = fixture::render(&spec);
         let file = format!("{name}.png");
-        crate::image_io::write_png16(&out.join(&file), &fx.frame).map_err(|e| e.to_string())?;
+        crate::imaging::image_io::write_png16(&out.join(&file), &fx.frame)
+            .map_err(|e| e.to_string())?;
         let [x0, y0, x1, y1] = fx.truth.to_array();
         csv.push_str(&format!("{file},{x0},{y0},{x1},{y1}\n"));
     }

@@ -16,8 +16,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 use tirroi_core::{BoxRule, Method, Roi};
 
-use crate::image_io::read_frame;
-use crate::run::{DetectorBank, median};
+use crate::eval::bank::{DetectorBank, median};
+use crate::imaging::image_io::read_frame;
+use crate::seed::{fnv1a64, stir};
 
 /// A row of `truth.csv`.
 #[derive(Debug, Clone, PartialEq)]
@@ -192,10 +193,9 @@ pub enum Track {
 /// side moved out or in by up to 10 % of the box's width or height (rounded), all from
 /// the FNV-1a hash of `file`; cut to the frame by the detector.
 pub fn jittered_prior(truth: Roi, file: &str) -> Roi {
-    let mut h = crate::tune::fnv1a64(file.as_bytes());
+    let mut h = fnv1a64(file.as_bytes());
     let mut next = |n: i32| {
-        h ^= h >> 29;
-        h = h.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h = stir(h);
         let v = ((h >> 33) % (2 * n as u64 + 1)) as i32;
         v - n
     };

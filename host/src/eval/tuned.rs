@@ -1,12 +1,12 @@
-//! Detector parameters tuned on rendered datasets with [`crate::tune`], one set per
+//! Detector parameters tuned on rendered datasets with [`crate::eval::tune`], one set per
 //! kind of scene, as constants.
 //!
 //! Every set came from `tirroi tune` on the *tune* part of a dataset (the frames whose
-//! file name hashes below 30 %: [`crate::tune::split_of`]); the test part never took
+//! file name hashes below 30 %: [`crate::eval::tune::split_of`]); the test part never took
 //! part in the choice. The datasets use seed 1, neither the presets' own seeds (2025,
 //! 2026) nor those of the datasets `tirroi paper` scores (the presets' + 1000), so that
 //! no scored frame shares a scene with a tuning frame at any `--count` (see the split
-//! caveat in [`crate::tune`]). The commands:
+//! caveat in [`crate::eval::tune`]). The commands:
 //!
 //! ```text
 //! tirroi render --preset paper --count 4800 --seed 1 --out paper-4800-s1
@@ -50,7 +50,7 @@ use tirroi_core::roi::dog::Dog;
 use tirroi_core::roi::otsu::Otsu;
 use tirroi_core::roi::wge::Wge;
 
-use crate::run::DetectorBank;
+use crate::eval::bank::DetectorBank;
 
 /// The scene kinds with their own tuned parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -191,9 +191,9 @@ pub const TANGO_DOG: Dog = Dog {
 /// A detector bank with the tuned parameters of `kind` (each detector with its own
 /// box rule).
 ///
-/// [`crate::eval::score`] sets one box rule for every detector after `make_bank`; to
+/// [`crate::eval::scoring::score`] sets one box rule for every detector after `make_bank`; to
 /// keep these rules, score one method at a time with its rule (as
-/// [`crate::tune::evaluate`] does).
+/// [`crate::eval::tune::evaluate`] does).
 pub fn tuned_bank(kind: TunedFor) -> DetectorBank {
     let (otsu, adaptive, wge, dog) = match kind {
         TunedFor::Radiometry => (
@@ -236,8 +236,8 @@ mod tests {
 
     #[test]
     fn tuned_sets_run_on_a_fixture() {
-        let (_, spec) = crate::fixture::standard_set()[1];
-        let fx = crate::fixture::render(&spec);
+        let (_, spec) = crate::imaging::fixture::standard_set()[1];
+        let fx = crate::imaging::fixture::render(&spec);
         let view = fx.frame.view().unwrap();
         for kind in TunedFor::ALL {
             let mut bank = tuned_bank(kind);

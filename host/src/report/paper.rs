@@ -12,10 +12,12 @@ use std::path::{Path, PathBuf};
 use tirroi_core::Method;
 
 use crate::dataset::{self, WriteOptions};
-use crate::eval::{self, EvalOptions, FrameScore, TruthRow};
-use crate::scene::SceneFile;
-use crate::tuned::{TunedFor, tuned_bank};
-use crate::{plots, progress, tune};
+use crate::eval::scoring::{self, EvalOptions, FrameScore, TruthRow};
+use crate::eval::tune;
+use crate::eval::tuned::{TunedFor, tuned_bank};
+use crate::progress;
+use crate::report::plots;
+use crate::world::scene::SceneFile;
 
 /// One row of the paper's Tables 6–8: method, group, mean IoU, median IoU, mean time (ms).
 pub type PaperRow = (&'static str, &'static str, f64, f64, f64);
@@ -59,7 +61,7 @@ pub const TABLE8: [PaperRow; 2] = [
 ];
 
 /// Added to each preset's seed for the evaluation datasets, so that none of their frames
-/// took part in the tuning (`crate::tuned` used seed 1; this keeps the evaluation
+/// took part in the tuning (`crate::eval::tuned` used seed 1; this keeps the evaluation
 /// datasets independent of the presets' own seeds too).
 pub const EVAL_SEED_OFFSET: u64 = 1000;
 
@@ -104,7 +106,7 @@ fn dataset(
         file.rescale_count(n).map_err(|e| e.to_string())?;
     }
     let truth = dir.join("truth.csv");
-    let reuse = eval::read_truth(&truth)
+    let reuse = scoring::read_truth(&truth)
         .map(|rows| rows.len() == file.image_count())
         .unwrap_or(false);
     if reuse {
@@ -123,7 +125,7 @@ fn dataset(
         };
         dataset::write_dataset(&file, dir, &options).map_err(|e| e.to_string())?;
     }
-    eval::read_truth(&truth).map_err(|e| e.to_string())
+    scoring::read_truth(&truth).map_err(|e| e.to_string())
 }
 
 fn has(row: &TruthRow, key: &str, value: &str) -> bool {
@@ -149,9 +151,9 @@ fn score(
         repeat: options.repeat,
         box_rule: None,
         bits: None,
-        track: eval::Track::Off,
+        track: scoring::Track::Off,
     };
-    let scores = eval::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
+    let scores = scoring::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
         bar.inc(1)
     })
     .map_err(|e| e.to_string())?;
@@ -220,14 +222,14 @@ fn ours(
     key: &str,
     value: &str,
     band: &str,
-) -> eval::GroupStats {
+) -> scoring::GroupStats {
     let sel: Vec<&FrameScore> = scores
         .iter()
         .filter(|s| s.method == method)
         .filter(|s| key.is_empty() || group_of(s, key) == Some(value))
         .filter(|s| group_of(s, "range") == Some(band))
         .collect();
-    eval::stats(method, key, value, &sel)
+    scoring::stats(method, key, value, &sel)
 }
 
 /// One table beside the paper's: method, group, ours (mean, median IoU, hit rate, mean
@@ -416,8 +418,8 @@ impl DatasetDirs {
     }
 }
 
-fn load(dir: &Path, file: &str) -> Result<crate::image_io::FrameBuf, String> {
-    crate::image_io::read_frame(&dir.join(file), Some(14)).map_err(|e| e.to_string())
+fn load(dir: &Path, file: &str) -> Result<crate::imaging::image_io::FrameBuf, String> {
+    crate::imaging::image_io::read_frame(&dir.join(file), Some(14)).map_err(|e| e.to_string())
 }
 
 /// Per file: the truth and each method's box.
@@ -457,7 +459,7 @@ fn example_grid(
     methods: &[&str],
     path: &Path,
 ) -> Result<(), String> {
-    let frames: Vec<(String, crate::image_io::FrameBuf)> = picks
+    let frames: Vec<(String, crate::imaging::image_io::FrameBuf)> = picks
         .iter()
         .map(|(file, caption)| Ok((caption.clone(), load(dir, file)?)))
         .collect::<Result<_, String>>()?;
@@ -617,7 +619,7 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
     let p = out.join("fig16-boxes-tango.png");
     example_grid(&dirs.tango, &scores.tango, &picks, &["adaptive", "wge"], &p)?;
     written.push(p);
-    let frames: Vec<crate::image_io::FrameBuf> = tango_files
+    let frames: Vec<crate::imaging::image_io::FrameBuf> = tango_files
         .iter()
         .map(|f| load(&dirs.tango, f))
         .collect::<Result<_, _>>()?;
@@ -639,7 +641,7 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
     // Run time against IoU: every candidate parameter set of the tuning grid on the
     // close-range radiometry frames of the test split (one run per frame).
     let dir = &dirs.paper;
-    let rows = eval::read_truth(&dir.join("truth.csv")).map_err(|e| e.to_string())?;
+    let rows = scoring::read_truth(&dir.join("truth.csv")).map_err(|e| e.to_string())?;
     let rows: Vec<TruthRow> = tune::split(&rows, tune::Split::Test)
         .into_iter()
         .filter(|r| has(r, "mode", "radiometry") && has(r, "range", "close"))

@@ -44,7 +44,7 @@
 //!
 //! That is 2 + 126 + 144 + 96 (+ 12 for auto) grid sets; the refinement adds some 20–150 trials per
 //! method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
-//! [`eval::score`] (in parallel, one run each); while the grids run, each pass over
+//! [`scoring::score`] (in parallel, one run each); while the grids run, each pass over
 //! the frames scores one grid set of every method, so a frame is decoded once per pass
 //! rather than once per set. Measured (release, 2 cores shared with other work): four
 //! methods on 88 tune frames in 16–21 s, on 367–373 tune frames in 32–90 s.
@@ -59,8 +59,9 @@ use tirroi_core::roi::otsu::Otsu;
 use tirroi_core::roi::wge::Wge;
 use tirroi_core::{BoxRule, Detector, Method};
 
-use crate::eval::{self, EvalError, EvalOptions, FrameScore, GROUP_COLUMNS, TruthRow};
-use crate::run::DetectorBank;
+use crate::eval::bank::DetectorBank;
+use crate::eval::scoring::{self, EvalError, EvalOptions, FrameScore, GROUP_COLUMNS, TruthRow};
+use crate::seed::{fnv1a64, splitmix64_finalise};
 
 /// Percentage of frames (by file-name hash) in the [`Split::Tune`] part.
 pub const TUNE_PERCENT: u64 = 30;
@@ -74,27 +75,10 @@ pub enum Split {
     Test,
 }
 
-/// 64-bit FNV-1a hash of `bytes` (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
-pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
-/// The SplitMix64 finaliser: a bijection that spreads every input bit over the output.
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The part a frame belongs to: [`Split::Tune`] when `mix64(fnv1a64(file)) % 100 <`
+/// The part a frame belongs to: [`Split::Tune`] when `splitmix64_finalise(fnv1a64(file)) % 100 <`
 /// [`TUNE_PERCENT`].
 pub fn split_of(file: &str) -> Split {
-    if mix64(fnv1a64(file.as_bytes())) % 100 < TUNE_PERCENT {
+    if splitmix64_finalise(fnv1a64(file.as_bytes())) % 100 < TUNE_PERCENT {
         Split::Tune
     } else {
         Split::Test
@@ -115,7 +99,7 @@ pub struct Where {
     /// Group column: one of [`GROUP_COLUMNS`] or `range`.
     pub key: String,
     /// Value the column must have (for `range`: `close`, `mid` or `far`, see
-    /// [`eval::range_band`]).
+    /// [`scoring::range_band`]).
     pub value: String,
 }
 
@@ -602,7 +586,7 @@ pub fn evaluate_together(
         repeat: 1,
         box_rule: None,
         bits,
-        track: eval::Track::Off,
+        track: scoring::Track::Off,
     };
     let make_bank = || {
         let mut bank = DetectorBank::default();
@@ -611,13 +595,13 @@ pub fn evaluate_together(
         }
         bank
     };
-    let scores = eval::score(images, rows, &options, &make_bank, &|| {})?;
+    let scores = scoring::score(images, rows, &options, &make_bank, &|| {})?;
     Ok(sets
         .iter()
         .map(|p| {
             let name = p.method().name();
             let mine: Vec<&FrameScore> = scores.iter().filter(|s| s.method == name).collect();
-            let s = eval::stats(name, "all", "all", &mine);
+            let s = scoring::stats(name, "all", "all", &mine);
             Trial {
                 method: name,
                 params: p.describe(),
@@ -762,7 +746,7 @@ pub fn search(
         }
     }
     // Largest-component sets first, then all-foreground ones: the scoring order decides
-    // ties (the first scored wins), and the tuned sets in `crate::tuned` came from it.
+    // ties (the first scored wins), and the tuned sets in `crate::eval::tuned` came from it.
     for rule in [BoxRule::LargestComponent, BoxRule::AllForeground] {
         let lists: Vec<Vec<Params>> = searches
             .iter()
@@ -880,7 +864,7 @@ pub fn run(args: &TuneArgs) -> Result<(), String> {
         .truth
         .clone()
         .unwrap_or_else(|| args.images.join("truth.csv"));
-    let rows = eval::read_truth(&truth).map_err(|e| e.to_string())?;
+    let rows = scoring::read_truth(&truth).map_err(|e| e.to_string())?;
     let rows = filter(&rows, &args.wheres);
     if rows.is_empty() {
         let w: Vec<String> = args
@@ -975,14 +959,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn fnv_reference_vectors() {
-        // Published FNV-1a 64 test vectors.
-        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
-        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
-        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
-    }
-
-    #[test]
     fn grids_hold_the_defaults_and_are_valid() {
         for m in Method::ALL {
             let g = grid(m);
@@ -1013,10 +989,10 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("tirroi-tune-rules-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let mut rows = Vec::new();
-        for (name, spec) in crate::fixture::standard_set() {
-            let fx = crate::fixture::render(&spec);
+        for (name, spec) in crate::imaging::fixture::standard_set() {
+            let fx = crate::imaging::fixture::render(&spec);
             let file = format!("{name}.png");
-            crate::image_io::write_png16(&dir.join(&file), &fx.frame).unwrap();
+            crate::imaging::image_io::write_png16(&dir.join(&file), &fx.frame).unwrap();
             rows.push(TruthRow {
                 file,
                 roi: fx.truth,

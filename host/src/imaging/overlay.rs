@@ -5,7 +5,7 @@ use std::path::Path;
 use image::{Rgb, RgbImage};
 use tirroi_core::Roi;
 
-use crate::image_io::{FrameBuf, FrameFileError};
+use crate::imaging::image_io::{FrameBuf, FrameFileError};
 
 /// Box colours: truth, then one per detector in `Method::ALL` order.
 pub const TRUTH_COLOUR: [u8; 3] = [0, 220, 0];

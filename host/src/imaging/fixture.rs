@@ -12,7 +12,7 @@ use rand_pcg::Pcg64;
 use tirroi_core::Roi;
 use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_WIDTH};
 
-use crate::image_io::FrameBuf;
+use crate::imaging::image_io::FrameBuf;
 
 /// What lies behind the target.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

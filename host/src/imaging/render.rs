@@ -39,10 +39,10 @@ use tirroi_core::sensor::{
     SensorError, expose_frame,
 };
 
-use crate::earth::EarthMap;
-use crate::geom::{Rotation, Vec3, dot, norm, scale, sub};
-use crate::scene::Camera;
-use crate::target::Mesh;
+use crate::world::earth::EarthMap;
+use crate::world::geom::{Rotation, Vec3, dot, norm, scale, sub};
+use crate::world::scene::Camera;
+use crate::world::spacecraft::Mesh;
 
 /// Sub-samples per axis on a partial pixel (4 × 4 = 16 per pixel).
 pub const SUPERSAMPLES_PER_AXIS: usize = 4;
@@ -473,7 +473,7 @@ fn render_target(
     let verts: Vec<Vec3> = mesh
         .vertices
         .iter()
-        .map(|v| crate::geom::add(r.apply(*v), target.centre_m))
+        .map(|v| crate::world::geom::add(r.apply(*v), target.centre_m))
         .collect();
     let nearest = verts.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
     if nearest.is_nan() || nearest <= 0.1 {
@@ -496,7 +496,7 @@ fn render_target(
     let (w, h) = (cam.w as f64, cam.h as f64);
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let n_cam = r.apply(mesh.normal(t));
-        let c_cam = crate::geom::add(r.apply(mesh.centroid(t)), target.centre_m);
+        let c_cam = crate::world::geom::add(r.apply(mesh.centroid(t)), target.centre_m);
         if dot(n_cam, c_cam) >= 0.0 {
             continue; // back face
         }

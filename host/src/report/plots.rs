@@ -13,8 +13,8 @@
 //! panel per group or frame are [`panel_figure_size`]; the example grid's size follows
 //! its frames (see [`example_grid`]).
 //!
-//! Colours: truth [`figure::TRUTH_COLOUR`]; the methods `otsu`, `adaptive`, `wge`, `dog`
-//! (names compared without case) take [`figure::METHOD_COLOURS`] in that order, and any
+//! Colours: truth [`overlay::TRUTH_COLOUR`]; the methods `otsu`, `adaptive`, `wge`, `dog`
+//! (names compared without case) take [`overlay::METHOD_COLOURS`] in that order, and any
 //! other method name takes the next of [`EXTRA_METHOD_COLOURS`] in order of first
 //! appearance in the input. Legends list the four known methods first, in that order,
 //! then the others by first appearance.
@@ -36,9 +36,9 @@ use plotters::style::register_font;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use tirroi_core::Roi;
 
-use crate::figure;
-use crate::image_io::FrameBuf;
-use crate::run::median;
+use crate::eval::bank::median;
+use crate::imaging::image_io::FrameBuf;
+use crate::imaging::overlay;
 
 /// Width of single-panel figures, px.
 pub const WIDTH: u32 = 800;
@@ -61,7 +61,7 @@ const FRAME_COLOURS: [[u8; 3]; 6] = [
 
 /// The embedded font: DejaVu Sans 2.37 (Bitstream Vera licence, see
 /// `host/assets/DejaVuSans-LICENSE.txt`).
-const FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 const FONT_FAMILY: &str = "sans-serif";
 
 /// Why a figure could not be drawn or written; the message names the file.
@@ -430,7 +430,7 @@ pub fn gradient_distribution(frames: &[GradientFrame], path: &Path) -> Result<()
             root,
             "Gradient magnitude (Prewitt, L2) inside and outside the truth box",
         )?;
-        let inside_colour = rgb(figure::TRUTH_COLOUR);
+        let inside_colour = rgb(overlay::TRUTH_COLOUR);
         let outside_colour = RGBColor(90, 90, 90);
         let entries = [
             LegendEntry {
@@ -518,7 +518,7 @@ pub fn gradient_distribution(frames: &[GradientFrame], path: &Path) -> Result<()
 }
 
 /// Figs. 11, 13, 16: example frames side by side (one column per frame), each
-/// contrast-stretched to gray ([`figure::frame_with_boxes`]) with the truth box and each
+/// contrast-stretched to gray ([`overlay::frame_with_boxes`]) with the truth box and each
 /// method's box in its colour, the caption under it, then one line per method with its
 /// IoU against the truth (or "no box"), and a legend strip at the bottom.
 ///
@@ -558,13 +558,13 @@ pub fn example_grid(frames: &[ExampleFrame], path: &Path) -> Result<(), PlotErro
                 height: f.height,
                 bits: 16,
             };
-            let mut boxes = vec![(f.truth, figure::TRUTH_COLOUR)];
+            let mut boxes = vec![(f.truth, overlay::TRUTH_COLOUR)];
             for (m, roi) in &f.boxes {
                 if let Some(roi) = roi {
                     boxes.push((*roi, palette.rgb(m)));
                 }
             }
-            figure::frame_with_boxes(&frame, &boxes, scale)
+            overlay::frame_with_boxes(&frame, &boxes, scale)
         })
         .collect();
     const GAP: u32 = 12;
@@ -575,7 +575,7 @@ pub fn example_grid(frames: &[ExampleFrame], path: &Path) -> Result<(), PlotErro
         images.iter().map(|i| i.width().max(180)).sum::<u32>() + GAP * (images.len() as u32 + 1);
     let mut entries = vec![LegendEntry {
         label: "truth".into(),
-        colour: rgb(figure::TRUTH_COLOUR),
+        colour: rgb(overlay::TRUTH_COLOUR),
         kind: LegendKind::Box,
     }];
     entries.extend(palette.names.iter().enumerate().map(|(i, n)| LegendEntry {
@@ -1126,7 +1126,7 @@ impl Palette {
         for (k, name) in KNOWN_METHODS.iter().enumerate() {
             if known[k] {
                 p.names.push((*name).to_string());
-                p.colours.push(rgb(figure::METHOD_COLOURS[k]));
+                p.colours.push(rgb(overlay::METHOD_COLOURS[k]));
             }
         }
         for (i, name) in extra.into_iter().enumerate() {

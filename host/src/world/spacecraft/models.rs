@@ -44,7 +44,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::mesh::{CylinderSpec, Material, Mesh, MeshBuilder, Part, divisions};
-use crate::geom::{Vec3, norm, sub};
+use crate::world::geom::{Vec3, norm, sub};
 
 /// Recommended facet edge length of both targets for close range (15–50 m, pixels of
 /// 13–44 mm): 0.05 m, fine enough to carry the conduction gradients and to keep the
@@ -154,7 +154,7 @@ fn clamp_resolution(resolution_m: f64) -> f64 {
 
 /// The paper's simplified target (Section 4.1): a 1.0 m cube with a Ø 0.5 m × 1.0 m
 /// cylinder attached to its +x face, axis along body +x (sizes and the 9-pixel check
-/// in the [module docs](crate::target::models)).
+/// in the [module docs](crate::world::spacecraft::models)).
 ///
 /// Parts: 0 `"cube"`, 1 `"cylinder"`, grey ([`grey_aluminium_skin`]) with the Table 3
 /// emissivities of `case`; no internal dissipation (the paper's target is passive).
@@ -278,7 +278,7 @@ pub const TANGO_DISSIPATION_W: f64 = 10.0;
 
 /// A Tango-like satellite (PRISMA's Tango, ref. \[14\] of the paper): box bus, one
 /// body-mounted solar panel on +z, three whip antennas and two patch antennas.
-/// Sizes, sources and estimates are listed in the [module docs](crate::target::models).
+/// Sizes, sources and estimates are listed in the [module docs](crate::world::spacecraft::models).
 ///
 /// Parts: 0 `"bus-radiator"` ([`WHITE_PAINT`], ±y walls), 1 `"bus-mli"`
 /// ([`MLI_KAPTON`], ±x walls and −z face), 2 `"solar-cells"` ([`SOLAR_CELLS`], panel

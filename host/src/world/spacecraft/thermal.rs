@@ -57,7 +57,7 @@ use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 
 use super::mesh::Mesh;
-use crate::geom::{Vec3, add, cross, dot, norm, normalize, scale, sub};
+use crate::world::geom::{Vec3, add, cross, dot, norm, normalize, scale, sub};
 
 /// Conductance of a joint between attached parts per metre of joint line,
 /// W m⁻¹ K⁻¹: a bolted or bonded aluminium flange of about 2 cm width with an
@@ -1262,8 +1262,8 @@ pub fn solve_steady_state(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::target::mesh::{Material, MeshBuilder, Part};
-    use crate::target::models::{MaterialCase, cube_cylinder, tango};
+    use crate::world::spacecraft::mesh::{Material, MeshBuilder, Part};
+    use crate::world::spacecraft::models::{MaterialCase, cube_cylinder, tango};
 
     fn sheet(kt_w_k: f64) -> Material {
         Material {

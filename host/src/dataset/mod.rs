@@ -33,15 +33,19 @@ use serde::{Deserialize, Serialize};
 use tirroi_core::Roi;
 use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
 
-use crate::earth::{EarthMap, OlrGrid};
-use crate::geom::{Rotation, Vec3, normalize, scale};
-use crate::image_io::{self, FrameBuf};
-use crate::render::{self, EarthView, Readout, RenderInput, RenderStats, Rendered, TargetView};
-use crate::scene::{EarthSource, Illumination, Mode, SceneFile, TargetModel};
-use crate::target::{
+use crate::imaging::image_io::{self, FrameBuf};
+use crate::imaging::overlay;
+use crate::imaging::render::{
+    self, EarthView, Readout, RenderInput, RenderStats, Rendered, TargetView,
+};
+use crate::progress;
+use crate::seed::splitmix64;
+use crate::world::earth::{EarthMap, OlrGrid};
+use crate::world::geom::{Rotation, Vec3, normalize, scale};
+use crate::world::scene::{EarthSource, Illumination, Mode, SceneFile, TargetModel};
+use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
 };
-use crate::{figure, progress};
 
 /// Everything that fixes one image.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,16 +121,8 @@ impl ThermalKey {
     }
 }
 
-/// SplitMix64 finaliser: decorrelates seeds derived from (seed, index) pairs.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 fn rng_for(seed: u64, stream: u64, index: u64) -> Pcg64 {
-    Pcg64::seed_from_u64(mix(mix(seed ^ mix(stream)) ^ index))
+    Pcg64::seed_from_u64(splitmix64(splitmix64(seed ^ splitmix64(stream)) ^ index))
 }
 
 /// A direction uniform on the unit sphere.
@@ -151,7 +147,7 @@ fn pool_state(
         Illumination::Eclipse => None,
         Illumination::Sunlit => loop {
             let s = random_direction(&mut rng);
-            if crate::geom::dot(s, earth) < disc_cos {
+            if crate::world::geom::dot(s, earth) < disc_cos {
                 break Some(s);
             }
         },
@@ -252,9 +248,9 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     earth_rendered: spec.earth,
                     camera_to_earth,
                     earth_day,
-                    noise_seed: spec
-                        .noise
-                        .then(|| mix(mix(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))),
+                    noise_seed: spec.noise.then(|| {
+                        splitmix64(splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))
+                    }),
                 });
             }
         }
@@ -299,7 +295,7 @@ impl std::error::Error for DatasetError {}
 fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
     match file.earth_model.source {
         EarthSource::Builtin => Ok(OlrGrid::builtin(
-            mix(file.dataset.seed ^ 0xEA27) ^ day as u64,
+            splitmix64(file.dataset.seed ^ 0xEA27) ^ day as u64,
         )),
         EarthSource::Netcdf => load_netcdf(file),
     }
@@ -412,7 +408,7 @@ impl Library {
                     Illumination::Eclipse => olr_mean * f64::from(factor),
                 };
                 if let Some(s) = key.sun_body() {
-                    env.sun_earth_cos = (-crate::geom::dot(s, key.earth_body())).max(0.0);
+                    env.sun_earth_cos = (-crate::world::geom::dot(s, key.earth_body())).max(0.0);
                 }
                 let sol = solve_steady_state(mesh, &env).map_err(|e| {
                     DatasetError(format!(
@@ -681,7 +677,7 @@ fn write_image(
             height: frame.height,
             bits: file.camera.bits,
         };
-        let img = figure::frame_with_boxes(&buf, &[(frame.truth, figure::TRUTH_COLOUR)], 2);
+        let img = overlay::frame_with_boxes(&buf, &[(frame.truth, overlay::TRUTH_COLOUR)], 2);
         let path = dir.join("preview").join(&rec.file);
         let png = encode_png(
             img.as_raw(),

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use crate::geom::{Vec3, add, cross, dot, norm, normalize, scale, sub};
+use crate::world::geom::{Vec3, add, cross, dot, norm, normalize, scale, sub};
 
 /// Surface optical and conduction properties of a part.
 #[derive(Debug, Clone, Copy, PartialEq)]
