@@ -40,6 +40,7 @@ use crate::imaging::render::{
 };
 use crate::progress;
 use crate::seed::splitmix64;
+use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::earth::{EarthMap, OlrGrid};
 use crate::world::geom::{Rotation, Vec3, normalize, scale};
 use crate::world::scene::{EarthSource, Illumination, Mode, SceneFile, TargetModel};
@@ -392,7 +393,9 @@ impl Library {
         });
         thermal_keys.dedup();
         let radius_m = file.earth_model.radius_km * 1e3;
-        let distance_m = plans.first().map_or(10_871e3, |p| p.earth_distance_m);
+        let distance_m = plans
+            .first()
+            .map_or(EARTH_DISTANCE_M, |p| p.earth_distance_m);
         let thermal: HashMap<_, _> = thermal_keys
             .par_iter()
             .map(|key| {

@@ -32,6 +32,7 @@ use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::sensor::DetectionScale;
 use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
 
+use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
 use crate::world::spacecraft::MaterialCase;
 
@@ -314,7 +315,7 @@ impl Default for EarthModel {
             days: 2,
             mesh_deg: EarthMap::DEFAULT_MESH_DEG,
             eclipse_factor: ECLIPSE_FLUX_FACTOR,
-            radius_km: 6371.0,
+            radius_km: EARTH_RADIUS_M / 1e3,
         }
     }
 }
@@ -466,7 +467,7 @@ fn yes() -> bool {
     true
 }
 fn earth_distance() -> f64 {
-    10_871.0
+    EARTH_DISTANCE_M / 1e3
 }
 fn off_boresight() -> Param {
     Param::Range {

@@ -57,6 +57,7 @@ use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 
 use super::mesh::Mesh;
+use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::geom::{Vec3, add, cross, dot, norm, normalize, scale, sub};
 
 /// Conductance of a joint between attached parts per metre of joint line,
@@ -71,11 +72,6 @@ pub const CONTACT_TOLERANCE_M: f64 = 1e-6;
 
 /// Default solar constant, W m⁻² (total solar irradiance at 1 au, Kopp and Lean 2011).
 pub const SOLAR_CONSTANT_W_M2: f64 = 1361.0;
-/// Default Earth radius, m (mean radius).
-pub const EARTH_RADIUS_M: f64 = 6_371e3;
-/// Default target–Earth centre distance, m: the paper's camera–Earth distance of
-/// 10 871 km (4 500 km altitude, Section 4.1).
-pub const EARTH_DISTANCE_M: f64 = 6_371e3 + 4_500e3;
 /// Default Earth top-of-atmosphere longwave flux, W m⁻² (global annual mean, about
 /// 240 W m⁻²; a scene passes the mean of its OLR map instead).
 pub const EARTH_OLR_W_M2: f64 = 240.0;
