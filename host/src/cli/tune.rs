@@ -7,10 +7,8 @@ use tirroi_core::BoxRule;
 
 use super::methods::{MethodChoice, parse_methods};
 use crate::eval::scoring;
-use crate::eval::tune::{
-    Params, SearchOptions, Split, TUNE_PERCENT, Where, evaluate, filter, grid, parse_where, search,
-    split, trials_csv,
-};
+use crate::eval::split::{Split, TUNE_PERCENT, Where, filter, parse_where, split};
+use crate::eval::tune::{Params, SearchOptions, evaluate, grid, search, trials_csv};
 use crate::progress;
 
 /// The options of `tirroi tune`.

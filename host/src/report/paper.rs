@@ -13,8 +13,8 @@ use tirroi_core::Method;
 
 use crate::dataset::{self, WriteOptions};
 use crate::eval::scoring::{self, EvalOptions, FrameScore, TruthRow};
-use crate::eval::tune;
 use crate::eval::tuned::{TunedFor, tuned_bank};
+use crate::eval::{split, tune};
 use crate::progress;
 use crate::report::plots;
 use crate::world::scene::SceneFile;
@@ -177,7 +177,7 @@ pub fn run(options: &PaperOptions) -> Result<PaperScores, String> {
     } = DatasetDirs::of(options);
     // Scores come from the test split only (`tune::split`), of datasets whose seeds the
     // tuning never used (`EVAL_SEED_OFFSET`).
-    let test = |rows: Vec<TruthRow>| tune::split(&rows, tune::Split::Test);
+    let test = |rows: Vec<TruthRow>| split::split(&rows, split::Split::Test);
     let paper_rows = test(dataset("paper", paper_count, &paper_dir, options.progress)?);
     let tango_rows = test(dataset("tango", tango_count, &tango_dir, options.progress)?);
     let (radiometry, detection): (Vec<TruthRow>, Vec<TruthRow>) = paper_rows
@@ -642,7 +642,7 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
     // close-range radiometry frames of the test split (one run per frame).
     let dir = &dirs.paper;
     let rows = scoring::read_truth(&dir.join("truth.csv")).map_err(|e| e.to_string())?;
-    let rows: Vec<TruthRow> = tune::split(&rows, tune::Split::Test)
+    let rows: Vec<TruthRow> = split::split(&rows, split::Split::Test)
         .into_iter()
         .filter(|r| has(r, "mode", "radiometry") && has(r, "range", "close"))
         .take(150)
