@@ -55,7 +55,7 @@ pub struct Where {
     /// Group column: one of [`GROUP_COLUMNS`] or `range`.
     pub key: String,
     /// Value the column must have (for `range`: `close`, `mid` or `far`, see
-    /// [`scoring::range_band`]).
+    /// [`crate::eval::scoring::range_band`]).
     pub value: String,
 }
 

@@ -2,7 +2,7 @@
 //! kind of scene, as constants.
 //!
 //! Every set came from `tirroi tune` on the *tune* part of a dataset (the frames whose
-//! file name hashes below 30 %: [`crate::eval::tune::split_of`]); the test part never took
+//! file name hashes below 30 %: [`crate::eval::split::split_of`]); the test part never took
 //! part in the choice. The datasets use seed 1, neither the presets' own seeds (2025,
 //! 2026) nor those of the datasets `tirroi paper` scores (the presets' + 1000), so that
 //! no scored frame shares a scene with a tuning frame at any `--count` (see the split

@@ -7,7 +7,7 @@
 //!
 //! **Target.** Each facet's band radiance comes from the core's table
 //! ([`BandLut::radiance_f32`], T and ε of the facet) and its flux from the core's Eq. 4
-//! ([`facet_flux_w_m2`]) at the facet centroid, as the paper's per-mesh-element flux.
+//! ([`facet_flux_w_m2`](tirroi_core::sensor::flux::facet_flux_w_m2)) at the facet centroid, as the paper's per-mesh-element flux.
 //! Facets are rasterised (back faces culled, nearest wins by 1/z) inside the target's
 //! projected bounds only. A pixel is *partial* when a facet touches its square
 //! (conservative test) but its centre or one of its 8 neighbours' centres is not

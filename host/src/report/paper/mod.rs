@@ -180,7 +180,7 @@ pub fn run(options: &PaperOptions) -> Result<PaperScores, String> {
         paper: paper_dir,
         tango: tango_dir,
     } = DatasetDirs::of(options);
-    // Scores come from the test split only (`tune::split`), of datasets whose seeds the
+    // Scores come from the test split only (`split::split`), of datasets whose seeds the
     // tuning never used (`EVAL_SEED_OFFSET`).
     let test = |rows: Vec<TruthRow>| split::split(&rows, split::Split::Test);
     let paper_rows = test(dataset("paper", paper_count, &paper_dir, options.progress)?);

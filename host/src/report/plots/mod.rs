@@ -13,8 +13,8 @@
 //! panel per group or frame are [`panel_figure_size`]; the example grid's size follows
 //! its frames (see [`example_grid`]).
 //!
-//! Colours: truth [`overlay::TRUTH_COLOUR`]; the methods `otsu`, `adaptive`, `wge`, `dog`
-//! (names compared without case) take [`overlay::METHOD_COLOURS`] in that order, and any
+//! Colours: truth [`TRUTH_COLOUR`](crate::imaging::overlay::TRUTH_COLOUR); the methods `otsu`, `adaptive`, `wge`, `dog`
+//! (names compared without case) take [`METHOD_COLOURS`](crate::imaging::overlay::METHOD_COLOURS) in that order, and any
 //! other method name takes the next of [`EXTRA_METHOD_COLOURS`] in order of first
 //! appearance in the input. Legends list the four known methods first, in that order,
 //! then the others by first appearance.

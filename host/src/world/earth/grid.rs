@@ -57,7 +57,7 @@ impl OlrGrid {
     }
 
     /// Every flux times `factor` (the eclipse scaling of Section 3.2.2, e.g.
-    /// [`ECLIPSE_FLUX_FACTOR`]). The result stays a valid grid: products above 500 W m⁻²
+    /// [`ECLIPSE_FLUX_FACTOR`](super::ECLIPSE_FLUX_FACTOR)). The result stays a valid grid: products above 500 W m⁻²
     /// are clamped to 500, and a negative or NaN factor counts as 0.
     pub fn scaled(&self, factor: f32) -> OlrGrid {
         let factor = if factor >= 0.0 { factor } else { 0.0 };
