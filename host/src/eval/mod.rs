@@ -8,7 +8,7 @@
 //! - [`tuned`]: the parameter sets that search produced, one per dataset kind.
 //!
 //! Imports [`imaging`](crate::imaging) (frame files) and lower stages, never
-//! [`report`](crate::report) or [`cli`](crate::cli). Inside the stage: `bank` ←
+//! `report` or `cli`. Inside the stage: `bank` ←
 //! `scoring` ← `split` ← `tune`; `tuned` needs only `bank`.
 
 pub mod bank;

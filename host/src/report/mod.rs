@@ -4,7 +4,7 @@
 //!   sets and prints Tables 6–8 beside the paper's;
 //! - [`plots`]: the PNG figures.
 //!
-//! Imports every lower stage, never [`cli`](crate::cli).
+//! Imports every lower stage, never `cli`.
 
 pub mod paper;
 pub mod plots;
