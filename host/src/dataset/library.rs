@@ -42,7 +42,7 @@ pub struct Library {
     pub build_s: [f64; 3],
 }
 
-pub(super) fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
+fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
     match file.earth_model.source {
         EarthSource::Builtin => Ok(OlrGrid::builtin(
             splitmix64(file.dataset.seed ^ 0xEA27) ^ day as u64,
@@ -52,14 +52,14 @@ pub(super) fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetE
 }
 
 #[cfg(feature = "netcdf")]
-pub(super) fn load_netcdf(file: &SceneFile) -> Result<OlrGrid, DatasetError> {
+fn load_netcdf(file: &SceneFile) -> Result<OlrGrid, DatasetError> {
     let m = &file.earth_model;
-    let path = m.path.as_deref().unwrap_or(Path::new(""));
+    let path = m.path.as_deref().unwrap_or(std::path::Path::new(""));
     OlrGrid::load_netcdf(path, &m.variable, m.time_index).map_err(|e| DatasetError(e.to_string()))
 }
 
 #[cfg(not(feature = "netcdf"))]
-pub(super) fn load_netcdf(_file: &SceneFile) -> Result<OlrGrid, DatasetError> {
+fn load_netcdf(_file: &SceneFile) -> Result<OlrGrid, DatasetError> {
     Err(DatasetError(
         "earth_model.source = \"netcdf\" needs tirroi built with `--features netcdf` (and the system libnetcdf); use source = \"builtin\" otherwise".into(),
     ))
