@@ -76,7 +76,7 @@ pub(super) fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), DatasetError
 }
 
 /// PNG bytes through [`image_io::encode_png`], errors naming the file.
-pub(super) fn encode_png(
+fn encode_png(
     bytes: &[u8],
     width: u32,
     height: u32,
@@ -87,7 +87,7 @@ pub(super) fn encode_png(
         .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))
 }
 
-pub(super) fn record(
+fn record(
     file: &SceneFile,
     plan: &ImagePlan,
     frame: &Rendered,

@@ -83,12 +83,12 @@ impl ThermalKey {
     }
 }
 
-pub(super) fn rng_for(seed: u64, stream: u64, index: u64) -> Pcg64 {
+fn rng_for(seed: u64, stream: u64, index: u64) -> Pcg64 {
     Pcg64::seed_from_u64(splitmix64(splitmix64(seed ^ splitmix64(stream)) ^ index))
 }
 
 /// A direction uniform on the unit sphere.
-pub(super) fn random_direction(rng: &mut Pcg64) -> Vec3 {
+fn random_direction(rng: &mut Pcg64) -> Vec3 {
     let z: f64 = rng.gen_range(-1.0..1.0);
     let phi: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
     let s = (1.0 - z * z).sqrt();
@@ -97,7 +97,7 @@ pub(super) fn random_direction(rng: &mut Pcg64) -> Vec3 {
 
 /// The Sun and Earth directions (body frame) of thermal state `k`: the Earth anywhere,
 /// the Sun anywhere it is not hidden by the Earth's disc (sunlit).
-pub(super) fn pool_state(
+fn pool_state(
     seed: u64,
     illumination: Illumination,
     k: usize,

@@ -32,7 +32,7 @@ pub fn box_rule_name(rule: BoxRule) -> &'static str {
     }
 }
 
-pub(super) fn other_rule(rule: BoxRule) -> BoxRule {
+fn other_rule(rule: BoxRule) -> BoxRule {
     match rule {
         BoxRule::AllForeground => BoxRule::LargestComponent,
         BoxRule::LargestComponent => BoxRule::AllForeground,
@@ -202,7 +202,7 @@ impl Params {
 }
 
 /// The nearest ladder values below and above `v` (either may be missing).
-pub(super) fn steps<T: PartialOrd + Copy>(ladder: &[T], v: T) -> Vec<T> {
+fn steps<T: PartialOrd + Copy>(ladder: &[T], v: T) -> Vec<T> {
     let below = ladder.iter().rev().find(|&&x| x < v).copied();
     let above = ladder.iter().find(|&&x| x > v).copied();
     below.into_iter().chain(above).collect()

@@ -12,7 +12,7 @@ use crate::world::geom::{Vec3, dot, norm, scale, sub};
 
 /// Earth signal along the unit ray `d`, or `None` when it misses.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct EarthRays<'a> {
+struct EarthRays<'a> {
     pub(super) view: &'a EarthView<'a>,
     pub(super) centre_distance_m: f64,
     /// |c|² − R².

@@ -39,7 +39,7 @@ impl Range {
 
 /// A facet projected to the image: vertices (u, v) and 1/z.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Edge {
+struct Edge {
     pub(super) a: f64,
     pub(super) b: f64,
     pub(super) c: f64,
@@ -68,7 +68,7 @@ impl Edge {
 }
 
 /// A front-facing facet ready for rasterisation.
-pub(super) struct ScreenTriangle {
+struct ScreenTriangle {
     pub(super) edges: [Edge; 3],
     pub(super) inv_area2: f64,
     pub(super) inv_z: [f64; 3],

@@ -35,12 +35,12 @@ impl DatasetDirs {
     }
 }
 
-pub(super) fn load(dir: &Path, file: &str) -> Result<crate::imaging::image_io::FrameBuf, String> {
+fn load(dir: &Path, file: &str) -> Result<crate::imaging::image_io::FrameBuf, String> {
     crate::imaging::image_io::read_frame(&dir.join(file), Some(14)).map_err(|e| e.to_string())
 }
 
 /// Per file: the truth and each method's box.
-pub(super) fn boxes_of(
+fn boxes_of(
     scores: &[FrameScore],
     file: &str,
 ) -> (tirroi_core::Roi, Vec<(String, Option<tirroi_core::Roi>)>) {
@@ -57,7 +57,7 @@ pub(super) fn boxes_of(
 }
 
 /// Close-range files of `scores` with `key = value`, in file order.
-pub(super) fn files_where(scores: &[FrameScore], key: &str, value: &str) -> Vec<String> {
+fn files_where(scores: &[FrameScore], key: &str, value: &str) -> Vec<String> {
     let mut files: Vec<String> = scores
         .iter()
         .filter(|s| group_of(s, "range") == Some("close"))
@@ -69,7 +69,7 @@ pub(super) fn files_where(scores: &[FrameScore], key: &str, value: &str) -> Vec<
     files
 }
 
-pub(super) fn example_grid(
+fn example_grid(
     dir: &Path,
     scores: &[FrameScore],
     picks: &[(String, String)],
@@ -101,7 +101,7 @@ pub(super) fn example_grid(
     plots::example_grid(&examples, path).map_err(|e| e.to_string())
 }
 
-pub(super) fn range_of(scores: &[FrameScore], file: &str) -> f64 {
+fn range_of(scores: &[FrameScore], file: &str) -> f64 {
     scores
         .iter()
         .find(|s| s.file == file)

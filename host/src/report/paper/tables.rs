@@ -14,7 +14,7 @@ pub(super) fn group_of<'a>(s: &'a FrameScore, key: &str) -> Option<&'a str> {
 }
 
 /// Our numbers for (method, group) over `scores` filtered to a range band.
-pub(super) fn ours(
+fn ours(
     scores: &[FrameScore],
     method: &str,
     key: &str,

@@ -16,8 +16,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::{EXTRA_METHOD_COLOURS, FONT_BYTES, FONT_FAMILY, PlotError};
 use crate::imaging::overlay;
 
-pub(super) type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
-pub(super) type DrawResult = Result<(), Box<dyn Error>>;
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+type DrawResult = Result<(), Box<dyn Error>>;
 
 pub(super) fn fail(path: &Path, what: impl fmt::Display) -> PlotError {
     PlotError(format!("{}: {what}", path.display()))
@@ -150,8 +150,8 @@ pub(super) struct LegendEntry {
     pub(super) kind: LegendKind,
 }
 
-pub(super) const SWATCH: i32 = 26;
-pub(super) const ENTRY_GAP: i32 = 22;
+const SWATCH: i32 = 26;
+const ENTRY_GAP: i32 = 22;
 
 pub(super) fn legend_width(entries: &[LegendEntry]) -> u32 {
     entries
@@ -162,7 +162,7 @@ pub(super) fn legend_width(entries: &[LegendEntry]) -> u32 {
 }
 
 /// Text width and height, px, in the legend font.
-pub(super) fn text_size(s: &str) -> (u32, u32) {
+fn text_size(s: &str) -> (u32, u32) {
     text(14)
         .font
         .box_size(s)
@@ -279,7 +279,7 @@ pub(super) struct Palette {
     pub(super) colours: Vec<RGBColor>,
 }
 
-pub(super) const KNOWN_METHODS: [&str; 4] = ["otsu", "adaptive", "wge", "dog"];
+const KNOWN_METHODS: [&str; 4] = ["otsu", "adaptive", "wge", "dog"];
 
 impl Palette {
     pub(super) fn new<'a>(names: impl Iterator<Item = &'a str>) -> Palette {
@@ -336,7 +336,7 @@ impl Palette {
     }
 }
 
-pub(super) fn known_index(name: &str) -> Option<usize> {
+fn known_index(name: &str) -> Option<usize> {
     KNOWN_METHODS
         .iter()
         .position(|k| k.eq_ignore_ascii_case(name.trim()))

@@ -41,7 +41,7 @@ const LON_NAMES: [&str; 2] = ["lon", "longitude"];
 /// Tolerance on coordinate values, degrees.
 const COORD_TOL_DEG: f64 = 1e-3;
 
-pub(super) fn load(path: &Path, variable: &str, time_index: usize) -> Result<OlrGrid, EarthError> {
+fn load(path: &Path, variable: &str, time_index: usize) -> Result<OlrGrid, EarthError> {
     let path_buf = path.to_path_buf();
     if !path.is_file() {
         return Err(EarthError::Open {

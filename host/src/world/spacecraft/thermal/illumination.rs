@@ -55,7 +55,7 @@ pub(super) struct Bvh {
 }
 
 #[derive(Debug, Clone, Copy)]
-pub(super) struct BvhNode {
+struct BvhNode {
     lo: Vec3,
     hi: Vec3,
     /// Leaf: first index into `order`; inner: index of the right child (left = next).
@@ -160,12 +160,7 @@ impl Bvh {
 
     /// Calls `on_hit(facet, t)` for the facets hit, in boxes entered before the limit
     /// it returns (−∞ stops the traversal).
-    pub(super) fn traverse_ray(
-        &self,
-        origin: Vec3,
-        dir: Vec3,
-        mut on_hit: impl FnMut(usize, f64) -> f64,
-    ) {
+    fn traverse_ray(&self, origin: Vec3, dir: Vec3, mut on_hit: impl FnMut(usize, f64) -> f64) {
         if self.nodes.is_empty() {
             return;
         }
@@ -226,7 +221,7 @@ impl Bvh {
 }
 
 /// Entry distance of a ray into a box, if it meets it at t ≥ 0.
-pub(super) fn slab(origin: Vec3, inv: Vec3, lo: Vec3, hi: Vec3) -> Option<f64> {
+fn slab(origin: Vec3, inv: Vec3, lo: Vec3, hi: Vec3) -> Option<f64> {
     let mut t0 = 0.0_f64;
     let mut t1 = f64::INFINITY;
     for k in 0..3 {

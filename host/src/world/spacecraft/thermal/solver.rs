@@ -81,7 +81,7 @@ impl ThermalSolution {
     }
 }
 
-pub(super) fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
+fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let mut lo = f64::NAN;
     let mut hi = f64::NAN;
     for v in values {
@@ -221,7 +221,7 @@ impl ThermalNetwork {
     }
 
     /// y = (diag − offdiag G)·x.
-    pub(super) fn apply(&self, diag: &[f64], x: &[f64], y: &mut [f64]) {
+    fn apply(&self, diag: &[f64], x: &[f64], y: &mut [f64]) {
         for i in 0..x.len() {
             let (s, e) = (self.row[i] as usize, self.row[i + 1] as usize);
             let mut acc = diag[i] * x[i];
