@@ -11,7 +11,7 @@ use tirroi::core::roi::dog::{Dog, DogScratch};
 use tirroi::core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi::core::roi::wge::{Wge, WgeScratch};
 use tirroi::core::{Detector, Frame};
-use tirroi::host::fixture::{self, Fixture};
+use tirroi::host::imaging::fixture::{self, Fixture};
 
 fn frames() -> Vec<(&'static str, Fixture)> {
     fixture::standard_set()

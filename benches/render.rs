@@ -6,7 +6,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use tirroi::host::dataset::{Library, plan};
-use tirroi::host::scene::SceneFile;
+use tirroi::host::world::scene::SceneFile;
 
 fn frames(c: &mut Criterion) {
     let file = SceneFile::preset("quick").expect("the quick preset parses");

@@ -7,8 +7,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use tirroi::core::{BoxRule, Frame, Method};
 use tirroi::host::dataset::{Library, plan};
-use tirroi::host::run::DetectorBank;
-use tirroi::host::scene::SceneFile;
+use tirroi::host::eval::bank::DetectorBank;
+use tirroi::host::world::scene::SceneFile;
 
 /// One close-range pose per scene kind, fixed so that the frames are the same every run.
 const SCENES: &str = r#"

@@ -14,8 +14,8 @@ use tirroi::core::roi::dog::{Dog, DogScratch};
 use tirroi::core::roi::otsu::Otsu;
 use tirroi::core::roi::wge::Wge;
 use tirroi::core::{Detection, Detector, Method, Roi};
-use tirroi::host::fixture;
-use tirroi::host::image_io::read_frame;
+use tirroi::host::imaging::fixture;
+use tirroi::host::imaging::image_io::read_frame;
 
 fn stdout_lines(out: &Output) -> Vec<String> {
     String::from_utf8(out.stdout.clone())

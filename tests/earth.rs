@@ -1,4 +1,4 @@
-//! The Earth model (`tirroi::host::earth`, paper Section 3.2): Eq. 10 against hand
+//! The Earth model (`tirroi::host::world::earth`, paper Section 3.2): Eq. 10 against hand
 //! values, the 1° grid's validation, the Catmull-Rom refinement (exact at the nodes,
 //! no overshoot, periodic in longitude, clamped at the poles), eclipse scaling, and the
 //! statistics and determinism of the built-in synthetic OLR field.
@@ -6,7 +6,7 @@
 use tirroi::core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 use tirroi::core::sensor::rng::Xoshiro128pp;
 use tirroi::core::sensor::{BandLut, BandRadiance};
-use tirroi::host::earth::{
+use tirroi::host::world::earth::{
     BUILTIN_ZONAL_OLR_W_M2, ECLIPSE_FLUX_FACTOR, EarthError, EarthMap, OlrGrid,
     flux_to_temperature_k, interpolate_temperature_k,
 };

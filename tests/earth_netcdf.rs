@@ -12,7 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tirroi::host::earth::{EarthError, OlrGrid};
+use tirroi::host::world::earth::{EarthError, OlrGrid};
 
 const VAR: &str = "toa_lw_all_daily";
 

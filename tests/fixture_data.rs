@@ -1,4 +1,4 @@
-//! The host's procedural fixtures (`tirroi::host::fixture`) are committed as data in
+//! The host's procedural fixtures (`tirroi::host::imaging::fixture`) are committed as data in
 //! `core/tests/data/fixtures/` so that the core's tests read them without the host.
 //! This test keeps data and generator from drifting apart: the generator must still
 //! make exactly the committed frames and truth boxes.
@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tirroi::host::fixture::{render, standard_set};
+use tirroi::host::imaging::fixture::{render, standard_set};
 
 const REGENERATE: &str =
     "regenerate with `cargo run --release -- fixtures --out core/tests/data/fixtures`";

@@ -1,12 +1,12 @@
-//! `tirroi_host::plots`: every figure is a decodable PNG of its documented size, the same
+//! `tirroi_host::report::plots`: every figure is a decodable PNG of its documented size, the same
 //! input gives the same bytes, empty input is a "no data" error that writes nothing, and
 //! `pareto_front` agrees with a brute-force check.
 
 use std::path::Path;
 
 use tirroi::core::Roi;
-use tirroi::host::figure::{METHOD_COLOURS, TRUTH_COLOUR};
-use tirroi::host::plots::{
+use tirroi::host::imaging::overlay::{METHOD_COLOURS, TRUTH_COLOUR};
+use tirroi::host::report::plots::{
     self, ExampleFrame, GradientFrame, IouPoint, TradeoffPoint, example_grid,
     gradient_distribution, intensity_histogram, iou_against_distance, pareto_front,
     runtime_against_iou,

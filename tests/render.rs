@@ -5,12 +5,12 @@
 use tirroi::core::Roi;
 use tirroi::core::sensor::flux::SENSOR_AREA_M2;
 use tirroi::core::sensor::{BandLut, BandRadiance, DetectionScale, DnMapping};
-use tirroi::host::earth::{EarthMap, OlrGrid, flux_to_temperature_k};
-use tirroi::host::geom::{Rotation, Vec3};
-use tirroi::host::render::{EarthView, Readout, RenderInput, TargetView, render};
-use tirroi::host::scene::Camera;
-use tirroi::host::target::models::{closed_box, grey_aluminium_skin};
-use tirroi::host::target::{Material, MaterialCase, Mesh, Part, cube_cylinder};
+use tirroi::host::imaging::render::{EarthView, Readout, RenderInput, TargetView, render};
+use tirroi::host::world::earth::{EarthMap, OlrGrid, flux_to_temperature_k};
+use tirroi::host::world::geom::{Rotation, Vec3};
+use tirroi::host::world::scene::Camera;
+use tirroi::host::world::spacecraft::models::{closed_box, grey_aluminium_skin};
+use tirroi::host::world::spacecraft::{Material, MaterialCase, Mesh, Part, cube_cylinder};
 
 fn band() -> (BandRadiance, BandLut) {
     let band = BandRadiance::hayabusa2_tir();
@@ -58,7 +58,7 @@ fn projected_extent(mesh: &Mesh, r: &Rotation, centre: Vec3, f: f64) -> [f64; 4]
     [u0, u1, v0, v1]
 }
 
-fn detect_frame(mesh: &Mesh, r: Rotation, centre: Vec3) -> tirroi::host::render::Rendered {
+fn detect_frame(mesh: &Mesh, r: Rotation, centre: Vec3) -> tirroi::host::imaging::render::Rendered {
     let camera = Camera::default();
     let b = band();
     let temps = vec![290.0; mesh.facet_count()];
@@ -390,7 +390,7 @@ fn a_uniform_radiometry_scene_keeps_a_usable_range_and_noise() {
     let mut i = input(&camera, Readout::Radiometry, Some(target), None, &b);
     i.noise_seed = Some(5);
     let out = render(&i).unwrap();
-    let expected_sigma = 16383.0 / tirroi::host::render::MIN_RANGE_NETD as f32;
+    let expected_sigma = 16383.0 / tirroi::host::imaging::render::MIN_RANGE_NETD as f32;
     assert!(
         (out.noise_sigma_dn - expected_sigma).abs() < 0.02 * expected_sigma,
         "{}",

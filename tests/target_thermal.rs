@@ -7,9 +7,9 @@ use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use tirroi::host::target::models::{DEFAULT_RESOLUTION_M, closed_box};
-use tirroi::host::target::thermal::{ThermalNetwork, earth_view_factor};
-use tirroi::host::target::{
+use tirroi::host::world::spacecraft::models::{DEFAULT_RESOLUTION_M, closed_box};
+use tirroi::host::world::spacecraft::thermal::{ThermalNetwork, earth_view_factor};
+use tirroi::host::world::spacecraft::{
     Material, MaterialCase, Mesh, Part, ThermalEnvironment, ThermalError, cube_cylinder,
     solve_steady_state, tango,
 };

@@ -1,4 +1,4 @@
-//! `tirroi_host::tune` and `tirroi tune`: the tune/test split is a stable, disjoint
+//! `tirroi_host::eval::tune` and `tirroi tune`: the tune/test split is a stable, disjoint
 //! ~30 % partition; the search scores its whole grid (defaults included) and never does
 //! worse than the defaults on the frames it tunes on; bad arguments exit with code 2.
 
@@ -8,9 +8,10 @@ use std::path::Path;
 
 use cli_common::run;
 use tirroi_core::{BoxRule, Method, Roi};
-use tirroi_host::eval::{TruthRow, read_truth};
-use tirroi_host::image_io::{FrameBuf, write_png16};
-use tirroi_host::tune::{self, Params, SearchOptions, Split};
+use tirroi_host::eval::scoring::{TruthRow, read_truth};
+use tirroi_host::eval::split::{self, Split};
+use tirroi_host::eval::tune::{self, Params, SearchOptions};
+use tirroi_host::imaging::image_io::{FrameBuf, write_png16};
 
 fn row(file: &str) -> TruthRow {
     TruthRow {
@@ -28,18 +29,18 @@ fn names(n: usize) -> Vec<TruthRow> {
 #[test]
 fn split_is_stable_disjoint_and_about_thirty_percent() {
     let rows = names(200);
-    let tune = tune::split(&rows, Split::Tune);
-    let test = tune::split(&rows, Split::Test);
+    let tune = split::split(&rows, Split::Tune);
+    let test = split::split(&rows, Split::Test);
     // Deterministic: the same call gives the same rows, and the rule is a pure
     // function of the name (a row's part does not depend on the others).
-    assert_eq!(tune, tune::split(&rows, Split::Tune));
-    assert_eq!(test, tune::split(&rows, Split::Test));
+    assert_eq!(tune, split::split(&rows, Split::Tune));
+    assert_eq!(test, split::split(&rows, Split::Test));
     let reversed: Vec<TruthRow> = rows.iter().rev().cloned().collect();
-    let mut tune_rev = tune::split(&reversed, Split::Tune);
+    let mut tune_rev = split::split(&reversed, Split::Tune);
     tune_rev.reverse();
     assert_eq!(tune, tune_rev);
     for r in &rows {
-        let part = tune::split_of(&r.file);
+        let part = split::split_of(&r.file);
         assert_eq!(tune.contains(r), part == Split::Tune, "{}", r.file);
         // Disjoint and covering: each row in exactly one part.
         assert_ne!(tune.contains(r), test.contains(r), "{}", r.file);
@@ -51,12 +52,12 @@ fn split_is_stable_disjoint_and_about_thirty_percent() {
     let other: Vec<TruthRow> = (0..200)
         .map(|i| row(&format!("scene-{}/frame_{i}.tif", i % 7)))
         .collect();
-    let share = tune::split(&other, Split::Tune).len() as f64 / 200.0;
+    let share = split::split(&other, Split::Tune).len() as f64 / 200.0;
     assert!((0.2..=0.4).contains(&share), "tune share {share}");
     // Names keep their part forever: pinned against a changed hash or threshold
     // (computed independently from the documented rule, FNV-1a 64 then SplitMix64).
     let pinned: String = (0..12)
-        .map(|i| match tune::split_of(&format!("{i:06}.png")) {
+        .map(|i| match split::split_of(&format!("{i:06}.png")) {
             Split::Tune => 'T',
             Split::Test => 't',
         })
@@ -152,7 +153,7 @@ fn search_scores_the_whole_grid_and_beats_or_matches_the_defaults() {
     let dir = tempfile::tempdir().unwrap();
     let rows = write_dataset(dir.path(), 30);
     assert_eq!(read_truth(&dir.path().join("truth.csv")).unwrap(), rows);
-    let tune_rows = tune::split(&rows, Split::Tune);
+    let tune_rows = split::split(&rows, Split::Tune);
     assert!(tune_rows.len() >= 4, "{} tune frames", tune_rows.len());
     let options = SearchOptions {
         refine_steps: 3,

@@ -1,0 +1,66 @@
+//! `tirroi paper`: reproduces the paper's tables and figures.
+
+use std::path::PathBuf;
+
+use crate::report::paper;
+
+/// The options of `tirroi paper`.
+#[derive(Debug, clap::Args)]
+pub struct PaperArgs {
+    /// Where datasets, reports and figures go.
+    #[arg(long, default_value = "paper-run")]
+    pub out: PathBuf,
+    /// Where the figures go (PNG).
+    #[arg(long, default_value = "docs/paper")]
+    pub figures: PathBuf,
+    /// Full-size datasets: 12 000 + 1 000 images.
+    #[arg(long)]
+    pub full: bool,
+    /// Runs per frame and method for the timing (median).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub repeat: u32,
+}
+
+impl Default for PaperArgs {
+    /// The default command (`tirroi` alone): a reduced run into `paper-run`.
+    fn default() -> Self {
+        PaperArgs {
+            out: PathBuf::from("paper-run"),
+            figures: PathBuf::from("docs/paper"),
+            full: false,
+            repeat: 3,
+        }
+    }
+}
+
+/// Runs `tirroi paper`: the datasets, Tables 6–8 (printed and in `tables.md`) and the
+/// figures.
+///
+/// # Errors
+/// One line from any step.
+pub fn run(args: &PaperArgs) -> Result<(), String> {
+    let options = &paper::PaperOptions {
+        out: args.out.clone(),
+        figures: args.figures.clone(),
+        full: args.full,
+        repeat: args.repeat as usize,
+        progress: true,
+    };
+    let start = std::time::Instant::now();
+    let scores = paper::run(options)?;
+    let report = paper::report(&scores);
+    println!("{report}");
+    let path = options.out.join("tables.md");
+    std::fs::write(&path, &report).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    let figures = paper::figures(options, &scores)?;
+    println!("figures:");
+    for f in &figures {
+        println!("  {}", f.display());
+    }
+    println!(
+        "tables: {} ({:.0} s in all)",
+        path.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

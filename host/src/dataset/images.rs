@@ -1,0 +1,181 @@
+//! Rendering and writing one image: the PNG (written atomically), its optional mask
+//! and preview, and its [`ImageRecord`].
+
+use std::fs::{self};
+use std::path::Path;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::library::ThermalState;
+use super::plan::ImagePlan;
+use super::{DatasetError, WriteOptions};
+use crate::imaging::image_io::{self, FrameBuf};
+use crate::imaging::overlay;
+use crate::imaging::render::{self, Rendered};
+use crate::world::geom::Vec3;
+use crate::world::scene::{SceneFile, TargetModel};
+
+/// The labels and metadata of one image (a line of `metadata.jsonl`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageRecord {
+    /// Index.
+    pub index: usize,
+    /// PNG file name, relative to the dataset directory.
+    pub file: String,
+    /// Scene kind name.
+    pub scene: String,
+    /// Truth box [x0, y0, x1, y1) (all 0 when the target is not in the frame).
+    pub bbox: [u16; 4],
+    /// Pixels in the target mask (coverage ≥ 0.5).
+    pub mask_px: usize,
+    /// "radiometry" or "detection".
+    pub mode: String,
+    /// Table 5 scale (detection).
+    pub scale: Option<u8>,
+    /// Target model.
+    pub target: String,
+    /// Table 3 case (cube + cylinder).
+    pub material: Option<String>,
+    /// "sunlit" or "eclipse".
+    pub illumination: String,
+    /// Camera–target centre distance, m.
+    pub range_m: f64,
+    /// Target centre offset from the frame centre, px.
+    pub offset_px: [f64; 2],
+    /// Body → camera rotation, row-major.
+    pub body_to_camera: [[f64; 3]; 3],
+    /// Sun direction in the camera frame (sunlit).
+    pub sun_dir_camera: Option<Vec3>,
+    /// Earth centre direction in the camera frame.
+    pub earth_dir_camera: Vec3,
+    /// Fraction of the frame whose pixel centres see the Earth.
+    pub earth_fraction: f64,
+    /// DN map: gain a (DN per W m⁻²) and offset b (DN).
+    pub dn_gain: f64,
+    /// DN map offset b, DN.
+    pub dn_offset: f64,
+    /// Noise σ, DN (0: noise off).
+    pub noise_sigma_dn: f32,
+    /// Noise seed.
+    pub noise_seed: Option<u64>,
+    /// Coldest and hottest target facet, K.
+    pub target_temperature_k: [f64; 2],
+    /// Dataset seed.
+    pub dataset_seed: u64,
+}
+
+pub(super) fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
+    let tmp = path.with_extension(format!(
+        "{}.part",
+        path.extension().and_then(|e| e.to_str()).unwrap_or("")
+    ));
+    fs::write(&tmp, bytes)
+        .and_then(|()| fs::rename(&tmp, path))
+        .map_err(|e| DatasetError(format!("{}: cannot write: {e}", path.display())))
+}
+
+/// PNG bytes through [`image_io::encode_png`], errors naming the file.
+fn encode_png(
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    colour: image::ExtendedColorType,
+    path: &Path,
+) -> Result<Vec<u8>, DatasetError> {
+    image_io::encode_png(bytes, width, height, colour)
+        .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))
+}
+
+fn record(
+    file: &SceneFile,
+    plan: &ImagePlan,
+    frame: &Rendered,
+    thermal: &ThermalState,
+) -> ImageRecord {
+    let spec = &file.scenes[plan.scene];
+    ImageRecord {
+        index: plan.index,
+        file: format!("{:06}.png", plan.index),
+        scene: spec
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("scene-{}", plan.scene)),
+        bbox: frame.truth.to_array(),
+        mask_px: frame
+            .coverage
+            .iter()
+            .filter(|&&c| c >= render::MASK_COVERAGE)
+            .count(),
+        mode: plan.mode.label().into(),
+        scale: plan.scale,
+        target: plan.thermal.target.label().into(),
+        material: (plan.thermal.target == TargetModel::CubeCylinder)
+            .then(|| plan.thermal.material.label().to_string()),
+        illumination: plan.thermal.illumination.label().into(),
+        range_m: plan.range_m,
+        offset_px: plan.offset_px,
+        body_to_camera: plan.body_to_camera.0,
+        sun_dir_camera: plan.sun_dir_camera,
+        earth_dir_camera: plan.earth_dir_camera,
+        earth_fraction: frame.earth_fraction,
+        dn_gain: frame.mapping.gain_dn(),
+        dn_offset: frame.mapping.offset_dn(),
+        noise_sigma_dn: frame.noise_sigma_dn,
+        noise_seed: plan.noise_seed,
+        target_temperature_k: [thermal.min_max_k.0, thermal.min_max_k.1],
+        dataset_seed: file.dataset.seed,
+    }
+}
+
+/// Writes one image's files; returns its record and the encode/write seconds.
+pub(super) fn write_image(
+    dir: &Path,
+    file: &SceneFile,
+    plan: &ImagePlan,
+    frame: &Rendered,
+    thermal: &ThermalState,
+    options: &WriteOptions,
+) -> Result<(ImageRecord, f64), DatasetError> {
+    let t0 = Instant::now();
+    let rec = record(file, plan, frame, thermal);
+    let (w, h) = (frame.width as u32, frame.height as u32);
+    let path = dir.join(&rec.file);
+    let png = encode_png(
+        &image_io::native_bytes(&frame.dn),
+        w,
+        h,
+        image::ExtendedColorType::L16,
+        &path,
+    )?;
+    atomic_write(&path, &png)?;
+    if options.masks {
+        let mask: Vec<u8> = frame
+            .coverage
+            .iter()
+            .map(|c| (c * 255.0).round() as u8)
+            .collect();
+        let path = dir.join("masks").join(&rec.file);
+        let png = encode_png(&mask, w, h, image::ExtendedColorType::L8, &path)?;
+        atomic_write(&path, &png)?;
+    }
+    if options.preview {
+        let buf = FrameBuf {
+            pixels: frame.dn.clone(),
+            width: frame.width,
+            height: frame.height,
+            bits: file.camera.bits,
+        };
+        let img = overlay::frame_with_boxes(&buf, &[(frame.truth, overlay::TRUTH_COLOUR)], 2);
+        let path = dir.join("preview").join(&rec.file);
+        let png = encode_png(
+            img.as_raw(),
+            img.width(),
+            img.height(),
+            image::ExtendedColorType::Rgb8,
+            &path,
+        )?;
+        atomic_write(&path, &png)?;
+    }
+    Ok((rec, t0.elapsed().as_secs_f64()))
+}

@@ -1,0 +1,71 @@
+//! The label files of a finished dataset: `truth.csv`, `coco.json`, `metadata.jsonl`.
+
+use std::path::Path;
+
+use tirroi_core::Roi;
+
+use super::DatasetError;
+use super::images::{ImageRecord, atomic_write};
+use crate::world::scene::SceneFile;
+
+/// Writes `truth.csv`, `coco.json` and `metadata.jsonl` (each atomically).
+pub(super) fn write_labels<'a>(
+    file: &SceneFile,
+    dir: &Path,
+    records: impl Iterator<Item = &'a ImageRecord>,
+) -> Result<(), DatasetError> {
+    let mut csv = String::from(
+        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed\n",
+    );
+    let mut jsonl = String::new();
+    let mut images = Vec::new();
+    let mut annotations = Vec::new();
+    for r in records {
+        let [x0, y0, x1, y1] = r.bbox;
+        csv.push_str(&format!(
+            "{},{x0},{y0},{x1},{y1},{},{},{},{},{},{:.3},{:.4},{}\n",
+            r.file,
+            r.mode,
+            r.scale.map_or(String::new(), |s| s.to_string()),
+            r.target,
+            r.material.as_deref().unwrap_or(""),
+            r.illumination,
+            r.range_m,
+            r.earth_fraction,
+            r.noise_seed.map_or(String::new(), |s| s.to_string()),
+        ));
+        jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
+        jsonl.push('\n');
+        images.push(serde_json::json!({
+            "id": r.index + 1,
+            "file_name": r.file,
+            "width": file.camera.width,
+            "height": file.camera.height,
+        }));
+        let roi = Roi::new(x0, y0, x1, y1);
+        if !roi.is_empty() {
+            annotations.push(serde_json::json!({
+                "id": r.index + 1,
+                "image_id": r.index + 1,
+                "category_id": 1,
+                "bbox": [x0, y0, roi.width(), roi.height()],
+                "area": r.mask_px,
+                "iscrowd": 0,
+            }));
+        }
+    }
+    let coco = serde_json::json!({
+        "info": {
+            "description": format!("tirroi synthetic thermal-infrared dataset `{}`", file.dataset.name),
+            "version": env!("CARGO_PKG_VERSION"),
+        },
+        "images": images,
+        "annotations": annotations,
+        "categories": [{"id": 1, "name": "spacecraft", "supercategory": "target"}],
+    });
+    let coco = serde_json::to_string(&coco).map_err(|e| DatasetError(e.to_string()))?;
+    atomic_write(&dir.join("truth.csv"), csv.as_bytes())?;
+    atomic_write(&dir.join("coco.json"), coco.as_bytes())?;
+    atomic_write(&dir.join("metadata.jsonl"), jsonl.as_bytes())?;
+    Ok(())
+}

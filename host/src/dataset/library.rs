@@ -1,0 +1,250 @@
+//! The shared pieces of a dataset, computed once: meshes, thermal solutions, OLR grids
+//! and Earth maps.
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
+
+use super::DatasetError;
+use super::plan::{ImagePlan, ThermalKey};
+use crate::imaging::render::{self, EarthView, Readout, RenderInput, Rendered, TargetView};
+use crate::seed::splitmix64;
+use crate::world::constants::EARTH_DISTANCE_M;
+use crate::world::earth::{EarthMap, OlrGrid};
+use crate::world::geom::{normalize, scale};
+use crate::world::scene::{EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::spacecraft::{
+    MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
+};
+
+/// A thermal solution with the numbers the labels report.
+#[derive(Debug, Clone)]
+pub struct ThermalState {
+    /// Temperature per facet, K.
+    pub temperature_k: Vec<f64>,
+    /// Coldest and hottest facet, K.
+    pub min_max_k: (f64, f64),
+}
+
+/// Shared, precomputed pieces of a dataset.
+pub struct Library {
+    /// Band radiance of the camera.
+    pub band: BandRadiance,
+    /// Its fast table.
+    pub lut: BandLut,
+    pub(super) meshes: HashMap<(TargetModel, MaterialCase, u64), Arc<Mesh>>,
+    pub(super) thermal: HashMap<ThermalKey, Arc<ThermalState>>,
+    pub(super) earth: HashMap<(Illumination, usize), Arc<EarthMap>>,
+    /// Seconds spent building the library: meshes, thermal solutions, Earth maps.
+    pub build_s: [f64; 3],
+}
+
+fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
+    match file.earth_model.source {
+        EarthSource::Builtin => Ok(OlrGrid::builtin(
+            splitmix64(file.dataset.seed ^ 0xEA27) ^ day as u64,
+        )),
+        EarthSource::Netcdf => load_netcdf(file),
+    }
+}
+
+#[cfg(feature = "netcdf")]
+fn load_netcdf(file: &SceneFile) -> Result<OlrGrid, DatasetError> {
+    let m = &file.earth_model;
+    let path = m.path.as_deref().unwrap_or(std::path::Path::new(""));
+    OlrGrid::load_netcdf(path, &m.variable, m.time_index).map_err(|e| DatasetError(e.to_string()))
+}
+
+#[cfg(not(feature = "netcdf"))]
+fn load_netcdf(_file: &SceneFile) -> Result<OlrGrid, DatasetError> {
+    Err(DatasetError(
+        "earth_model.source = \"netcdf\" needs tirroi built with `--features netcdf` (and the system libnetcdf); use source = \"builtin\" otherwise".into(),
+    ))
+}
+
+impl Library {
+    /// Builds the meshes, thermal solutions and Earth maps `plans` use, in parallel.
+    ///
+    /// # Errors
+    /// [`DatasetError`] when an Earth source cannot be read or a thermal solve fails.
+    pub fn build(file: &SceneFile, plans: &[ImagePlan]) -> Result<Library, DatasetError> {
+        let band = BandRadiance::hayabusa2_tir();
+        let lut = BandLut::new(&band);
+        let t0 = Instant::now();
+        let mut mesh_keys: Vec<_> = plans.iter().map(|p| p.thermal.mesh_key()).collect();
+        mesh_keys.sort_by_key(|k| (k.0.label(), k.1.label(), k.2));
+        mesh_keys.dedup();
+        let meshes: HashMap<_, _> = mesh_keys
+            .par_iter()
+            .map(|&(t, m, res)| {
+                let r = f64::from_bits(res);
+                let mesh = match t {
+                    TargetModel::CubeCylinder => cube_cylinder(m, r),
+                    TargetModel::Tango => tango(r),
+                };
+                ((t, m, res), Arc::new(mesh))
+            })
+            .collect();
+        let t1 = Instant::now();
+
+        // Earth maps: one per (illumination, day); eclipse is the sunlit map scaled.
+        let mut earth_keys: Vec<(Illumination, usize)> = plans
+            .iter()
+            .filter(|p| p.earth_rendered)
+            .map(|p| (p.thermal.illumination, p.earth_day))
+            .collect();
+        earth_keys.sort_by_key(|k| (k.0.label(), k.1));
+        earth_keys.dedup();
+        let mut days: Vec<usize> = plans.iter().map(|p| p.earth_day).collect();
+        days.sort_unstable();
+        days.dedup();
+        // Ordered by day: the thermal network below takes the first day's mean flux, and
+        // a HashMap's per-process order would make that choice (and the bytes) vary.
+        let grids: BTreeMap<usize, OlrGrid> = days
+            .iter()
+            .map(|&d| Ok((d, olr_grid(file, d)?)))
+            .collect::<Result<_, DatasetError>>()?;
+        let factor = file.earth_model.eclipse_factor;
+        let earth: HashMap<_, _> = earth_keys
+            .par_iter()
+            .map(|&(ill, day)| {
+                let grid = &grids[&day];
+                let map = match ill {
+                    Illumination::Sunlit => EarthMap::refine(grid, file.earth_model.mesh_deg, &lut),
+                    Illumination::Eclipse => {
+                        EarthMap::refine(&grid.scaled(factor), file.earth_model.mesh_deg, &lut)
+                    }
+                };
+                map.map(|m| ((ill, day), Arc::new(m)))
+                    .map_err(|e| DatasetError(format!("Earth map: {e}")))
+            })
+            .collect::<Result<_, _>>()?;
+        let t2 = Instant::now();
+
+        // Thermal solutions: the mean flux of the first day used heats the target.
+        let olr_mean = grids
+            .values()
+            .next()
+            .map_or(240.0, |g| g.area_weighted_mean_w_m2());
+        let mut thermal_keys: Vec<ThermalKey> = plans.iter().map(|p| p.thermal).collect();
+        thermal_keys.sort_by_key(|k| {
+            (
+                k.target.label(),
+                k.material.label(),
+                k.resolution_bits,
+                k.illumination.label(),
+                k.sun_body_bits,
+                k.earth_body_bits,
+            )
+        });
+        thermal_keys.dedup();
+        let radius_m = file.earth_model.radius_km * 1e3;
+        let distance_m = plans
+            .first()
+            .map_or(EARTH_DISTANCE_M, |p| p.earth_distance_m);
+        let thermal: HashMap<_, _> = thermal_keys
+            .par_iter()
+            .map(|key| {
+                let mesh = &meshes[&key.mesh_key()];
+                let mut env = match key.sun_body() {
+                    Some(s) => ThermalEnvironment::sunlit(s, key.earth_body()),
+                    None => ThermalEnvironment::eclipse(key.earth_body()),
+                };
+                env.earth_radius_m = radius_m;
+                env.earth_distance_m = distance_m;
+                env.earth_olr_w_m2 = match key.illumination {
+                    Illumination::Sunlit => olr_mean,
+                    Illumination::Eclipse => olr_mean * f64::from(factor),
+                };
+                if let Some(s) = key.sun_body() {
+                    env.sun_earth_cos = (-crate::world::geom::dot(s, key.earth_body())).max(0.0);
+                }
+                let sol = solve_steady_state(mesh, &env).map_err(|e| {
+                    DatasetError(format!(
+                        "thermal solution of {} ({}, {}): {e}",
+                        key.target.label(),
+                        key.material.label(),
+                        key.illumination.label()
+                    ))
+                })?;
+                let min_max_k = sol.min_max_k();
+                Ok((
+                    *key,
+                    Arc::new(ThermalState {
+                        temperature_k: sol.temperature_k,
+                        min_max_k,
+                    }),
+                ))
+            })
+            .collect::<Result<_, DatasetError>>()?;
+        let t3 = Instant::now();
+        Ok(Library {
+            band,
+            lut,
+            meshes,
+            thermal,
+            earth,
+            build_s: [
+                (t1 - t0).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+            ],
+        })
+    }
+
+    /// Number of distinct meshes, thermal solutions and Earth maps.
+    pub fn counts(&self) -> (usize, usize, usize) {
+        (self.meshes.len(), self.thermal.len(), self.earth.len())
+    }
+
+    /// Renders one planned image.
+    ///
+    /// # Errors
+    /// [`DatasetError`] naming the image when the renderer refuses it.
+    pub fn render(
+        &self,
+        file: &SceneFile,
+        plan: &ImagePlan,
+    ) -> Result<(Rendered, Arc<ThermalState>), DatasetError> {
+        let mesh = &self.meshes[&plan.thermal.mesh_key()];
+        let thermal = self.thermal[&plan.thermal].clone();
+        let f = file.camera.focal_px();
+        let dir = normalize([plan.offset_px[0] / f, plan.offset_px[1] / f, 1.0]);
+        let earth = if plan.earth_rendered {
+            Some(EarthView {
+                map: &self.earth[&(plan.thermal.illumination, plan.earth_day)],
+                centre_m: scale(plan.earth_dir_camera, plan.earth_distance_m),
+                radius_m: file.earth_model.radius_km * 1e3,
+                camera_to_earth: plan.camera_to_earth,
+            })
+        } else {
+            None
+        };
+        let input = RenderInput {
+            camera: &file.camera,
+            readout: match plan.scale {
+                None => Readout::Radiometry,
+                Some(2) => Readout::Detection(DetectionScale::Scale2),
+                Some(3) => Readout::Detection(DetectionScale::Scale3),
+                Some(_) => Readout::Detection(DetectionScale::Scale1),
+            },
+            target: Some(TargetView {
+                mesh,
+                temperature_k: &thermal.temperature_k,
+                body_to_camera: plan.body_to_camera,
+                centre_m: scale(dir, plan.range_m),
+            }),
+            earth,
+            earth_distance_m: plan.earth_distance_m,
+            noise_seed: plan.noise_seed,
+            band: &self.band,
+            lut: &self.lut,
+        };
+        let frame = render::render(&input)
+            .map_err(|e| DatasetError(format!("image {}: {e}", plan.index)))?;
+        Ok((frame, thermal))
+    }
+}

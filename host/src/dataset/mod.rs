@@ -1,0 +1,185 @@
+//! Labelled datasets: a [`SceneFile`] becomes a plan of images (poses, Earth geometry,
+//! thermal state, seeds), the shared pieces (meshes, thermal solutions, Earth maps) are
+//! computed once, and the images render in parallel into a directory:
+//!
+//! - `NNNNNN.png`: 16-bit grayscale DN (the core's sensor model);
+//! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (DESIGN convention; the box is
+//!   the tight box of the pixels whose target coverage is ≥ 0.5);
+//! - `coco.json`: COCO detection labels (one category, `spacecraft`);
+//! - `metadata.jsonl`: one JSON object per image (pose, mode, scale, material,
+//!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures);
+//! - `masks/NNNNNN.png` (optional): 8-bit target coverage, 255 = fully covered;
+//! - `preview/NNNNNN.png` (optional): contrast-stretched 8-bit RGB with the truth box.
+//!
+//! Determinism: every image's parameters derive from the dataset seed and its index
+//! alone, so the bytes do not depend on the thread count. Safety: each file is written
+//! to a temporary name and renamed; finished images are journalled in `progress.jsonl`,
+//! and the label files are written (atomically) only when all images are done, so a
+//! stopped run leaves no label file describing missing images, and `--resume` continues
+//! where it stopped.
+
+use std::collections::BTreeMap;
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+
+use crate::imaging::render::RenderStats;
+use crate::progress;
+use crate::world::scene::SceneFile;
+
+mod images;
+mod labels;
+mod library;
+mod plan;
+
+pub use images::ImageRecord;
+pub use library::{Library, ThermalState};
+pub use plan::{ImagePlan, ThermalKey, plan};
+
+use images::write_image;
+use labels::write_labels;
+
+/// Why a dataset could not be made.
+#[derive(Debug)]
+pub struct DatasetError(pub String);
+
+impl std::fmt::Display for DatasetError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DatasetError {}
+
+/// Options of a dataset run.
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// Also write `masks/`.
+    pub masks: bool,
+    /// Also write `preview/`.
+    pub preview: bool,
+    /// Skip images already journalled in `progress.jsonl`.
+    pub resume: bool,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+/// Totals of a dataset run.
+#[derive(Debug, Clone, Default)]
+pub struct RunSummary {
+    /// Images rendered in this run.
+    pub rendered: usize,
+    /// Images skipped (resumed).
+    pub skipped: usize,
+    /// Wall-clock seconds: library build, rendering + writing, labels.
+    pub wall_s: [f64; 3],
+    /// Library build seconds per part: meshes, thermal, Earth maps.
+    pub library_s: [f64; 3],
+    /// Distinct meshes, thermal solutions and Earth maps.
+    pub library_counts: (usize, usize, usize),
+    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write.
+    pub stage_cpu_s: [f64; 4],
+}
+
+/// Renders every image of `file` into `dir` with labels (module docs).
+///
+/// # Errors
+/// [`DatasetError`] for unwritable outputs, bad Earth sources, or an image that cannot
+/// be rendered (named).
+pub fn write_dataset(
+    file: &SceneFile,
+    dir: &Path,
+    options: &WriteOptions,
+) -> Result<RunSummary, DatasetError> {
+    let t0 = Instant::now();
+    let io = |p: &Path, e: std::io::Error| DatasetError(format!("{}: {e}", p.display()));
+    fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    for (on, sub) in [(options.masks, "masks"), (options.preview, "preview")] {
+        if on {
+            let p = dir.join(sub);
+            fs::create_dir_all(&p).map_err(|e| io(&p, e))?;
+        }
+    }
+    let plans = plan(file);
+    let journal_path = dir.join("progress.jsonl");
+    let mut done: BTreeMap<usize, ImageRecord> = BTreeMap::new();
+    if options.resume && journal_path.exists() {
+        let f = File::open(&journal_path).map_err(|e| io(&journal_path, e))?;
+        for line in BufReader::new(f).lines().map_while(Result::ok) {
+            if let Ok(rec) = serde_json::from_str::<ImageRecord>(&line) {
+                if dir.join(&rec.file).exists() {
+                    done.insert(rec.index, rec);
+                }
+            }
+        }
+    }
+    let todo: Vec<&ImagePlan> = plans
+        .iter()
+        .filter(|p| !done.contains_key(&p.index))
+        .collect();
+    let library = Library::build(file, &plans)?;
+    let t1 = Instant::now();
+
+    let journal = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&journal_path)
+        .map_err(|e| io(&journal_path, e))?;
+    let journal = Mutex::new(journal);
+    let bar = if options.progress {
+        progress::bar(todo.len(), "images")
+    } else {
+        ProgressBar::hidden()
+    };
+    let results: Vec<Result<(ImageRecord, RenderStats, f64), DatasetError>> = todo
+        .par_iter()
+        .map(|plan| {
+            let (frame, thermal) = library.render(file, plan)?;
+            let (rec, write_s) = write_image(dir, file, plan, &frame, &thermal, options)?;
+            let line = serde_json::to_string(&rec).map_err(|e| DatasetError(e.to_string()))?;
+            {
+                let mut j = journal
+                    .lock()
+                    .map_err(|_| DatasetError("journal lock".into()))?;
+                writeln!(j, "{line}").map_err(|e| io(&journal_path, e))?;
+            }
+            bar.inc(1);
+            Ok((rec, frame.stats, write_s))
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut summary = RunSummary {
+        skipped: done.len(),
+        library_s: library.build_s,
+        library_counts: library.counts(),
+        ..RunSummary::default()
+    };
+    for r in results {
+        let (rec, stats, write_s) = r?;
+        summary.rendered += 1;
+        summary.stage_cpu_s[0] += stats.target_ns as f64 * 1e-9;
+        summary.stage_cpu_s[1] += stats.earth_ns as f64 * 1e-9;
+        summary.stage_cpu_s[2] += stats.expose_ns as f64 * 1e-9;
+        summary.stage_cpu_s[3] += write_s;
+        done.insert(rec.index, rec);
+    }
+    let t2 = Instant::now();
+    write_labels(file, dir, done.values())?;
+    fs::remove_file(&journal_path).map_err(|e| io(&journal_path, e))?;
+    summary.wall_s = [
+        (t1 - t0).as_secs_f64(),
+        (t2 - t1).as_secs_f64(),
+        t2.elapsed().as_secs_f64(),
+    ];
+    Ok(summary)
+}
+
+/// The output directory's label file, for callers that report it.
+pub fn truth_path(dir: &Path) -> PathBuf {
+    dir.join("truth.csv")
+}

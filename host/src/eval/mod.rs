@@ -1,0 +1,18 @@
+//! Stage 4, evaluation: running the flight detectors on labelled frames and scoring
+//! them.
+//!
+//! - [`bank`]: one detector of each method with its scratch, timed runs;
+//! - [`scoring`]: labels (`truth.csv`), per-frame IoU and time, group statistics, reports;
+//! - [`split`]: the tune/test split (a hash of the file name) and `--where` filters;
+//! - [`tune`]: the parameter search;
+//! - [`tuned`]: the parameter sets that search produced, one per dataset kind.
+//!
+//! Imports [`imaging`](crate::imaging) (frame files) and lower stages, never
+//! `report` or `cli`. Inside the stage: `bank` ←
+//! `scoring` ← `split` ← `tune`; `tuned` needs only `bank`.
+
+pub mod bank;
+pub mod scoring;
+pub mod split;
+pub mod tune;
+pub mod tuned;

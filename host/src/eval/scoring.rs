@@ -1,0 +1,525 @@
+//! Scoring detectors on a directory of frames with a `truth.csv` (ours or anyone's):
+//! IoU against the truth box and the core's run time, per method and per group
+//! (material case, scale, illumination, range band, target), as the paper's Tables 6–8.
+//!
+//! `truth.csv` needs the columns `file,x0,y0,x1,y1` first (DESIGN convention: x0, y0
+//! inclusive, x1, y1 exclusive); extra columns become group labels when they are one of
+//! `mode`, `scale`, `target`, `material`, `illumination`, and `range_m` gives the range
+//! band (close ≤ 50 m, far ≥ 300 m, else mid). Timing is the core call alone on one
+//! thread, the median of `repeat` runs; images are scored in parallel.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde::Serialize;
+use tirroi_core::{BoxRule, Method, Roi};
+
+use crate::eval::bank::{DetectorBank, median};
+use crate::imaging::image_io::read_frame;
+use crate::seed::{fnv1a64, stir};
+
+/// A row of `truth.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TruthRow {
+    /// Frame file, relative to the images directory.
+    pub file: String,
+    /// Truth box.
+    pub roi: Roi,
+    /// Group labels from the extra columns: (column, value).
+    pub groups: Vec<(String, String)>,
+    /// Camera–target distance, m, when the file has a `range_m` column.
+    pub range_m: Option<f64>,
+}
+
+/// Columns that become groups; `range_m` becomes `range` (close / mid / far).
+pub const GROUP_COLUMNS: [&str; 5] = ["mode", "scale", "target", "material", "illumination"];
+
+/// Why an evaluation could not run; `Display` is one line naming the file (and line).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvalError(pub String);
+
+impl fmt::Display for EvalError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for EvalError {}
+
+/// The range band of a camera–target distance: `close` (≤ 50 m, the paper's headline),
+/// `far` (≥ 300 m) or `mid`.
+pub fn range_band(range_m: f64) -> &'static str {
+    if range_m <= 50.0 {
+        "close"
+    } else if range_m >= 300.0 {
+        "far"
+    } else {
+        "mid"
+    }
+}
+
+/// Reads `truth.csv`.
+///
+/// # Errors
+/// [`EvalError`] naming the file and line for a missing header, a short row, or a box
+/// that is not four integers with x0 ≤ x1, y0 ≤ y1.
+pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| EvalError(format!("{}: cannot read: {e}", path.display())))?;
+    let mut lines = text.lines().enumerate();
+    let header: Vec<&str> = match lines.next() {
+        Some((_, h)) => h.split(',').map(str::trim).collect(),
+        None => return Err(EvalError(format!("{}: empty file", path.display()))),
+    };
+    if header.len() < 5 || header[..5] != ["file", "x0", "y0", "x1", "y1"] {
+        return Err(EvalError(format!(
+            "{}:1: header `{}`: expected it to start with file,x0,y0,x1,y1",
+            path.display(),
+            header.join(",")
+        )));
+    }
+    let mut rows = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cols: Vec<&str> = line.split(',').map(str::trim).collect();
+        let at = || format!("{}:{}", path.display(), i + 1);
+        if cols.len() < 5 {
+            return Err(EvalError(format!(
+                "{}: {} columns: expected at least file,x0,y0,x1,y1",
+                at(),
+                cols.len()
+            )));
+        }
+        let mut b = [0u16; 4];
+        for (k, v) in b.iter_mut().enumerate() {
+            *v = cols[k + 1].parse().map_err(|_| {
+                EvalError(format!(
+                    "{}: {} = `{}`: expected an integer 0..=65535",
+                    at(),
+                    header[k + 1],
+                    cols[k + 1]
+                ))
+            })?;
+        }
+        if b[0] > b[2] || b[1] > b[3] {
+            return Err(EvalError(format!(
+                "{}: box {b:?}: expected x0 <= x1 and y0 <= y1",
+                at()
+            )));
+        }
+        let mut groups = Vec::new();
+        let mut range_m = None;
+        for (name, value) in header.iter().zip(&cols).skip(5) {
+            if value.is_empty() {
+                continue;
+            }
+            if GROUP_COLUMNS.contains(name) {
+                groups.push((name.to_string(), value.to_string()));
+            } else if *name == "range_m" {
+                if let Ok(r) = value.parse::<f64>() {
+                    groups.push(("range".into(), range_band(r).into()));
+                    range_m = Some(r);
+                }
+            }
+        }
+        rows.push(TruthRow {
+            file: cols[0].to_string(),
+            roi: Roi::new(b[0], b[1], b[2], b[3]),
+            groups,
+            range_m,
+        });
+    }
+    Ok(rows)
+}
+
+/// One detector on one frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameScore {
+    /// Frame file.
+    pub file: String,
+    /// Method name.
+    pub method: &'static str,
+    /// Predicted box, `None` when nothing was found.
+    pub bbox: Option<[u16; 4]>,
+    /// Truth box.
+    pub truth: [u16; 4],
+    /// IoU of prediction and truth (0 when none).
+    pub iou: f32,
+    /// Median core time over the repeats, µs.
+    pub time_us: f64,
+    /// Group labels.
+    pub groups: Vec<(String, String)>,
+    /// Camera–target distance, m, when known.
+    pub range_m: Option<f64>,
+}
+
+/// How to run an evaluation.
+#[derive(Debug, Clone)]
+pub struct EvalOptions {
+    /// Methods to run.
+    pub methods: Vec<Method>,
+    /// Runs per frame and method (median time).
+    pub repeat: usize,
+    /// Mask-to-box rule for every detector; `None` keeps each detector's own rule from
+    /// `make_bank` (e.g. tuned per method).
+    pub box_rule: Option<BoxRule>,
+    /// Bit depth of the frames (None: from the file, 14 for 16-bit files that fit).
+    pub bits: Option<u8>,
+    /// Where `auto` gets its tracking prior (the other methods have none).
+    pub track: Track,
+}
+
+/// Where `auto` gets its tracking prior during an evaluation ([`EvalOptions::track`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Track {
+    /// No prior: every frame is searched whole.
+    #[default]
+    Off,
+    /// The truth box as a tracker would hand it over: moved by up to ±4 px in x and y
+    /// and each side grown or shrunk by up to 10 % of the box size, from a hash of the
+    /// file name ([`jittered_prior`]), so the same frame always gets the same prior.
+    Jitter,
+    /// The frames, in file-name order, are one sequence: each frame's prior is `auto`'s
+    /// box on the previous frame (none on the first frame and after a miss). Frames
+    /// are scored one after the other on one thread.
+    Sequence,
+}
+
+/// The prior of [`Track::Jitter`]: `truth` moved by `dx, dy ∈ [−4, 4]` px and each
+/// side moved out or in by up to 10 % of the box's width or height (rounded), all from
+/// the FNV-1a hash of `file`; cut to the frame by the detector.
+pub fn jittered_prior(truth: Roi, file: &str) -> Roi {
+    let mut h = fnv1a64(file.as_bytes());
+    let mut next = |n: i32| {
+        h = stir(h);
+        let v = ((h >> 33) % (2 * n as u64 + 1)) as i32;
+        v - n
+    };
+    let (w, hh) = (i32::from(truth.width()), i32::from(truth.height()));
+    let (dx, dy) = (next(4), next(4));
+    let side = |size: i32, r: i32| (size * r + 50) / 100;
+    let x0 = i32::from(truth.x0) + dx - side(w, next(10));
+    let x1 = i32::from(truth.x1) + dx + side(w, next(10));
+    let y0 = i32::from(truth.y0) + dy - side(hh, next(10));
+    let y1 = i32::from(truth.y1) + dy + side(hh, next(10));
+    let c = |v: i32| v.clamp(0, i32::from(u16::MAX)) as u16;
+    Roi::new(c(x0), c(y0), c(x1), c(y1))
+}
+
+/// Scores every `(row, method)`; `make_bank` gives each worker thread its detectors
+/// (their parameters), so tuned or default parameters come from one place.
+///
+/// # Errors
+/// [`EvalError`] naming the frame for an unreadable file or a detector error.
+pub fn score(
+    images: &Path,
+    rows: &[TruthRow],
+    options: &EvalOptions,
+    make_bank: &(dyn Fn() -> DetectorBank + Sync),
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<FrameScore>, EvalError> {
+    if options.track == Track::Sequence {
+        return score_sequence(images, rows, options, make_bank, progress);
+    }
+    let per_row: Vec<Result<Vec<FrameScore>, EvalError>> = rows
+        .par_iter()
+        .map_init(
+            || {
+                let mut bank = make_bank();
+                if let Some(rule) = options.box_rule {
+                    bank.set_box_rule(rule);
+                }
+                bank
+            },
+            |bank, row| {
+                let path: PathBuf = images.join(&row.file);
+                let frame =
+                    read_frame(&path, options.bits).map_err(|e| EvalError(e.to_string()))?;
+                let view = frame
+                    .view()
+                    .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
+                let mut out = Vec::with_capacity(options.methods.len());
+                if options.track == Track::Jitter {
+                    bank.auto.prior = Some(jittered_prior(row.roi, &row.file));
+                }
+                for &m in &options.methods {
+                    out.push(score_one(bank, m, &view, row, &path, options.repeat)?.0);
+                }
+                progress();
+                Ok(out)
+            },
+        )
+        .collect();
+    let mut scores = Vec::new();
+    for r in per_row {
+        scores.extend(r?);
+    }
+    Ok(scores)
+}
+
+/// Runs `method` on one frame (`repeat` times, median time) and scores its box against
+/// the row's truth; also returns the box.
+fn score_one(
+    bank: &mut DetectorBank,
+    method: Method,
+    view: &tirroi_core::Frame<'_>,
+    row: &TruthRow,
+    path: &Path,
+    repeat: usize,
+) -> Result<(FrameScore, Option<Roi>), EvalError> {
+    let (d, time_us) = bank
+        .detect_timed(method, view, repeat)
+        .map_err(|e| EvalError(format!("{}: {method}: {e}", path.display())))?;
+    let score = FrameScore {
+        file: row.file.clone(),
+        method: method.name(),
+        bbox: d.roi.map(|r| r.to_array()),
+        truth: row.roi.to_array(),
+        iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
+        time_us,
+        groups: row.groups.clone(),
+        range_m: row.range_m,
+    };
+    Ok((score, d.roi))
+}
+
+/// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, `auto`'s
+/// prior from its box on the previous frame.
+fn score_sequence(
+    images: &Path,
+    rows: &[TruthRow],
+    options: &EvalOptions,
+    make_bank: &(dyn Fn() -> DetectorBank + Sync),
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<FrameScore>, EvalError> {
+    let mut bank = make_bank();
+    if let Some(rule) = options.box_rule {
+        bank.set_box_rule(rule);
+    }
+    let mut order: Vec<&TruthRow> = rows.iter().collect();
+    order.sort_by(|a, b| a.file.cmp(&b.file));
+    let mut previous = None;
+    let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
+    for row in order {
+        let path: PathBuf = images.join(&row.file);
+        let frame = read_frame(&path, options.bits).map_err(|e| EvalError(e.to_string()))?;
+        let view = frame
+            .view()
+            .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
+        bank.auto.prior = previous;
+        for &m in &options.methods {
+            let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
+            if m == Method::Auto {
+                previous = roi;
+            }
+            scores.push(score);
+        }
+        progress();
+    }
+    Ok(scores)
+}
+
+/// Statistics of one method over one group of frames.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GroupStats {
+    /// Method name.
+    pub method: String,
+    /// Group column (`all` for every frame).
+    pub group: String,
+    /// Group value.
+    pub value: String,
+    /// Frames.
+    pub frames: usize,
+    /// Mean IoU.
+    pub mean_iou: f64,
+    /// Median IoU.
+    pub median_iou: f64,
+    /// Fraction of frames with IoU ≥ 0.5.
+    pub hit_rate: f64,
+    /// Mean core time per frame, ms.
+    pub mean_time_ms: f64,
+    /// Median core time per frame, ms.
+    pub median_time_ms: f64,
+}
+
+/// Statistics of a set of scores.
+pub fn stats(method: &str, group: &str, value: &str, scores: &[&FrameScore]) -> GroupStats {
+    let n = scores.len();
+    let mut ious: Vec<f64> = scores.iter().map(|s| f64::from(s.iou)).collect();
+    let mut times: Vec<f64> = scores.iter().map(|s| s.time_us * 1e-3).collect();
+    let mean = |v: &[f64]| {
+        if v.is_empty() {
+            0.0
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
+    };
+    GroupStats {
+        method: method.into(),
+        group: group.into(),
+        value: value.into(),
+        frames: n,
+        mean_iou: mean(&ious),
+        hit_rate: if n == 0 {
+            0.0
+        } else {
+            ious.iter().filter(|&&v| v >= 0.5).count() as f64 / n as f64
+        },
+        median_iou: median(&mut ious),
+        mean_time_ms: mean(&times),
+        median_time_ms: median(&mut times),
+    }
+}
+
+/// Per method: all frames, then each value of each group column present.
+pub fn summarise(scores: &[FrameScore]) -> Vec<GroupStats> {
+    let mut methods: Vec<&'static str> = Vec::new();
+    for s in scores {
+        if !methods.contains(&s.method) {
+            methods.push(s.method);
+        }
+    }
+    let mut out = Vec::new();
+    for m in methods {
+        let mine: Vec<&FrameScore> = scores.iter().filter(|s| s.method == m).collect();
+        out.push(stats(m, "all", "all", &mine));
+        let mut by: BTreeMap<(String, String), Vec<&FrameScore>> = BTreeMap::new();
+        for s in &mine {
+            for (k, v) in &s.groups {
+                by.entry((k.clone(), v.clone())).or_default().push(s);
+            }
+        }
+        for ((k, v), group) in by {
+            out.push(stats(m, &k, &v, &group));
+        }
+    }
+    out
+}
+
+/// The statistics as a Markdown table.
+pub fn markdown(stats: &[GroupStats]) -> String {
+    let mut s = String::from(
+        "| method | group | frames | mean IoU | median IoU | IoU >= 0.5 | mean time [ms] | median time [ms] |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for g in stats {
+        let group = if g.group == "all" {
+            "all".to_string()
+        } else {
+            format!("{} = {}", g.group, g.value)
+        };
+        s.push_str(&format!(
+            "| {} | {group} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |\n",
+            g.method,
+            g.frames,
+            g.mean_iou,
+            g.median_iou,
+            g.hit_rate,
+            g.mean_time_ms,
+            g.median_time_ms
+        ));
+    }
+    s
+}
+
+/// Writes `scores.csv`, `summary.csv` and `summary.json` into `out`.
+///
+/// # Errors
+/// [`EvalError`] naming the file that cannot be written.
+pub fn write_reports(
+    out: &Path,
+    scores: &[FrameScore],
+    stats: &[GroupStats],
+) -> Result<(), EvalError> {
+    let io = |p: &Path, e: std::io::Error| EvalError(format!("{}: cannot write: {e}", p.display()));
+    std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
+    let mut csv =
+        String::from("file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us\n");
+    for s in scores {
+        let b = s.bbox.map_or(",,,".to_string(), |b| {
+            format!("{},{},{},{}", b[0], b[1], b[2], b[3])
+        });
+        let t = s.truth;
+        csv.push_str(&format!(
+            "{},{},{b},{},{},{},{},{:.4},{:.2}\n",
+            s.file, s.method, t[0], t[1], t[2], t[3], s.iou, s.time_us
+        ));
+    }
+    let p = out.join("scores.csv");
+    std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
+    let mut csv = String::from(
+        "method,group,value,frames,mean_iou,median_iou,hit_rate,mean_time_ms,median_time_ms\n",
+    );
+    for g in stats {
+        csv.push_str(&format!(
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4}\n",
+            g.method,
+            g.group,
+            g.value,
+            g.frames,
+            g.mean_iou,
+            g.median_iou,
+            g.hit_rate,
+            g.mean_time_ms,
+            g.median_time_ms
+        ));
+    }
+    let p = out.join("summary.csv");
+    std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
+    let p = out.join("summary.json");
+    let json = serde_json::to_string_pretty(stats).map_err(|e| EvalError(e.to_string()))?;
+    std::fs::write(&p, json).map_err(|e| io(&p, e))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn score(iou: f32, time_us: f64, groups: &[(&str, &str)]) -> FrameScore {
+        FrameScore {
+            file: "f.png".into(),
+            method: "otsu",
+            bbox: None,
+            truth: [0, 0, 1, 1],
+            iou,
+            time_us,
+            groups: groups
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+            range_m: None,
+        }
+    }
+
+    #[test]
+    fn stats_by_hand() {
+        let s = [
+            score(0.2, 100.0, &[("scale", "1")]),
+            score(0.6, 300.0, &[("scale", "1")]),
+            score(0.9, 200.0, &[("scale", "3")]),
+        ];
+        let all = summarise(&s);
+        assert_eq!(all.len(), 3);
+        let a = &all[0];
+        assert_eq!((a.group.as_str(), a.frames), ("all", 3));
+        assert!((a.mean_iou - (0.2 + 0.6 + 0.9) / 3.0).abs() < 1e-6);
+        assert!((a.median_iou - 0.6).abs() < 1e-6);
+        assert!((a.hit_rate - 2.0 / 3.0).abs() < 1e-12);
+        assert!((a.mean_time_ms - 0.2).abs() < 1e-12 && (a.median_time_ms - 0.2).abs() < 1e-12);
+        let s1 = &all[1];
+        assert_eq!((s1.value.as_str(), s1.frames), ("1", 2));
+        assert!((s1.median_iou - 0.4).abs() < 1e-6);
+    }
+
+    #[test]
+    fn range_bands() {
+        assert_eq!(range_band(15.0), "close");
+        assert_eq!(range_band(50.0), "close");
+        assert_eq!(range_band(120.0), "mid");
+        assert_eq!(range_band(440.0), "far");
+    }
+}

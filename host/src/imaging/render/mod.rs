@@ -1,0 +1,373 @@
+//! One frame: the detected flux of Eq. 4 per pixel from whichever surface the pixel sees
+//! (a target facet, the Earth, or deep space), then the core's DN conversion and noise.
+//!
+//! The camera is a pinhole at the origin looking along +z, x right and y down (the pixel
+//! grid's axes); pixel (i, j) spans [i, i+1) × [j, j+1) in image coordinates and the
+//! principal point is the frame centre.
+//!
+//! **Target.** Each facet's band radiance comes from the core's table
+//! ([`BandLut::radiance_f32`], T and ε of the facet) and its flux from the core's Eq. 4
+//! ([`facet_flux_w_m2`](tirroi_core::sensor::flux::facet_flux_w_m2)) at the facet centroid, as the paper's per-mesh-element flux.
+//! Facets are rasterised (back faces culled, nearest wins by 1/z) inside the target's
+//! projected bounds only. A pixel is *partial* when a facet touches its square
+//! (conservative test) but its centre or one of its 8 neighbours' centres is not
+//! covered; only partial pixels are supersampled (4 × 4 stratified samples) for their
+//! target coverage and mixed signal. Coverage is the fraction of samples on the target
+//! (1 for interior pixels).
+//!
+//! **Earth.** A sphere of radius R at the scene's centre position. A pixel's ray that
+//! hits it takes the band radiance of the Earth mesh cell there ([`EarthMap`]) and the
+//! flux of Eq. 4 with the local surface normal, the pixel's ray and |r| = the
+//! camera–Earth-centre distance (the paper's 10 871 km; this reading reproduces
+//! Table 5's q_max, `shared/reference/REFERENCE.md` §4). No Earth work is done for a
+//! frame whose field of view cannot reach the Earth's disc, nor for pixels fully on the
+//! target; pixels at the limb are supersampled like the target's edges.
+//!
+//! **Readout.** Radiometry mode turns q into F = D·q (Eq. 7) with D = π|r|²/ΔA_c per
+//! object (target: distance to its centre; Earth: to its centre) and auto-ranges the DN
+//! map over the frame's pure (unmixed) pixels (Eq. 17); detection mode uses the fixed
+//! Table 5 scale (Eq. 9). The core's [`expose_frame`] then adds the noise (Eq. 18,
+//! scaled to the NETD) and quantises.
+
+use std::time::Instant;
+
+use tirroi_core::Roi;
+use tirroi_core::sensor::noise::NoiseRms;
+use tirroi_core::sensor::{
+    BandLut, BandRadiance, DetectionScale, DnMapping, NoiseField, NoiseLevel, SENSOR_AREA_M2,
+    SensorError, expose_frame,
+};
+
+use crate::world::earth::EarthMap;
+use crate::world::geom::{Rotation, Vec3, norm, scale};
+use crate::world::scene::Camera;
+use crate::world::spacecraft::Mesh;
+
+mod earth;
+mod target;
+
+use earth::render_earth;
+use target::{Range, render_target};
+
+/// Sub-samples per axis on a partial pixel (4 × 4 = 16 per pixel).
+pub const SUPERSAMPLES_PER_AXIS: usize = 4;
+const SAMPLES: usize = SUPERSAMPLES_PER_AXIS * SUPERSAMPLES_PER_AXIS;
+const NO_FACET: u32 = u32::MAX;
+/// Narrowest radiometry range (Eq. 17), in NETDs of F at the reference temperature
+/// (10 × 0.4 K: 4 K at 300 K): a scene of (nearly) one temperature keeps a usable DN map.
+pub const MIN_RANGE_NETD: f64 = 10.0;
+/// Coverage at or above which a pixel belongs to the target's mask and truth box.
+pub const MASK_COVERAGE: f32 = 0.5;
+
+/// The target as the camera sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct TargetView<'a> {
+    /// The mesh in the body frame, m.
+    pub mesh: &'a Mesh,
+    /// Temperature per facet, K (the thermal solution).
+    pub temperature_k: &'a [f64],
+    /// Body frame → camera frame.
+    pub body_to_camera: Rotation,
+    /// The body origin (the target's centre) in the camera frame, m.
+    pub centre_m: Vec3,
+}
+
+/// The Earth as the camera sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct EarthView<'a> {
+    /// Band radiance per mesh cell.
+    pub map: &'a EarthMap,
+    /// The Earth's centre in the camera frame, m.
+    pub centre_m: Vec3,
+    /// Radius, m.
+    pub radius_m: f64,
+    /// Camera-frame directions → Earth-fixed frame (z north, x at longitude 0).
+    pub camera_to_earth: Rotation,
+}
+
+/// The camera mode and its DN map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Readout {
+    /// Radiometry, auto-ranged per frame (Eq. 17).
+    Radiometry,
+    /// Detection on a Table 5 scale.
+    Detection(DetectionScale),
+}
+
+/// Everything one frame needs.
+#[derive(Debug, Clone, Copy)]
+pub struct RenderInput<'a> {
+    /// Camera geometry and read-out.
+    pub camera: &'a Camera,
+    /// Mode.
+    pub readout: Readout,
+    /// The target, if any.
+    pub target: Option<TargetView<'a>>,
+    /// The Earth, if rendered.
+    pub earth: Option<EarthView<'a>>,
+    /// Camera–Earth-centre distance, m: the detection-mode noise is scaled to the NETD
+    /// of a face-on blackbody at this distance (the scene the Table 5 scales are built on).
+    pub earth_distance_m: f64,
+    /// Noise seed; `None` renders without noise (and skips the noise stage).
+    pub noise_seed: Option<u64>,
+    /// Band radiance (f64, for ∂L/∂T of the noise scale).
+    pub band: &'a BandRadiance,
+    /// Band radiance table (per facet and Earth cell radiances).
+    pub lut: &'a BandLut,
+}
+
+/// Time spent and work done per stage of one frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RenderStats {
+    /// Facet fluxes, rasterisation and supersampling, ns.
+    pub target_ns: u64,
+    /// Earth rays, lookups and limb supersampling, ns.
+    pub earth_ns: u64,
+    /// DN map, noise and quantisation (the core's `expose_frame`), ns.
+    pub expose_ns: u64,
+    /// Pixels inside the target's projected bounds.
+    pub target_region_px: usize,
+    /// Pixels supersampled at the target's edges.
+    pub target_partial_px: usize,
+    /// Earth rays cast (centre rays plus limb sub-samples); 0 when the Earth is out of view.
+    pub earth_rays: usize,
+}
+
+/// One rendered frame with its labels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    /// Width, px.
+    pub width: usize,
+    /// Height, px.
+    pub height: usize,
+    /// DN, row-major.
+    pub dn: Vec<u16>,
+    /// Signal before the DN map: F (W m⁻², radiometry) or q_fc (W m⁻², detection).
+    pub signal: Vec<f32>,
+    /// Target coverage per pixel, 0..=1.
+    pub coverage: Vec<f32>,
+    /// Tight box of the pixels with coverage ≥ [`MASK_COVERAGE`] (empty when none).
+    pub truth: Roi,
+    /// Fraction of the frame's pixels whose centre sees the Earth (not the target).
+    pub earth_fraction: f64,
+    /// The DN map used.
+    pub mapping: DnMapping,
+    /// Total noise σ, DN (0 without noise).
+    pub noise_sigma_dn: f32,
+    /// Stage times and counts.
+    pub stats: RenderStats,
+}
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RenderError {
+    /// The core refused a value (message names it).
+    Sensor(SensorError),
+    /// The target reaches the camera plane (too close for its size).
+    TargetTooClose {
+        /// The nearest vertex depth, m.
+        nearest_z_m: f64,
+    },
+    /// Inconsistent input (message says what).
+    Input(String),
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RenderError::Sensor(e) => write!(f, "camera model: {e}"),
+            RenderError::TargetTooClose { nearest_z_m } => write!(
+                f,
+                "the target reaches {nearest_z_m:.3} m in front of the camera: expected the whole target > 0.1 m ahead (increase range_m)"
+            ),
+            RenderError::Input(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+impl From<SensorError> for RenderError {
+    fn from(e: SensorError) -> Self {
+        RenderError::Sensor(e)
+    }
+}
+
+/// Pinhole projection of the camera.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Pinhole {
+    f: f64,
+    cx: f64,
+    cy: f64,
+    w: usize,
+    h: usize,
+}
+
+impl Pinhole {
+    fn new(c: &Camera) -> Self {
+        Pinhole {
+            f: c.focal_px(),
+            cx: c.width as f64 / 2.0,
+            cy: c.height as f64 / 2.0,
+            w: c.width,
+            h: c.height,
+        }
+    }
+
+    /// Unit ray through image point (u, v).
+    fn ray(&self, u: f64, v: f64) -> Vec3 {
+        let d = [(u - self.cx) / self.f, (v - self.cy) / self.f, 1.0];
+        scale(d, 1.0 / norm(d))
+    }
+
+    /// Half the diagonal field of view, rad.
+    fn half_diagonal_rad(&self) -> f64 {
+        (self.cx.hypot(self.cy) / self.f).atan()
+    }
+}
+
+/// Renders one frame.
+///
+/// # Errors
+/// [`RenderError`] for a target too close to the camera, temperatures that do not match
+/// the mesh, or values the core's camera model refuses.
+pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
+    let cam = Pinhole::new(input.camera);
+    let n = cam.w * cam.h;
+    let mut stats = RenderStats::default();
+    // Per pixel: target coverage and the target's share of the signal.
+    let mut coverage = vec![0f32; n];
+    let mut signal = vec![0f32; n];
+    // Pure pixels (all target or all Earth) bound the radiometry range (Eq. 17).
+    let mut pure = Range::default();
+
+    let t0 = Instant::now();
+    if let Some(target) = &input.target {
+        render_target(
+            &cam,
+            target,
+            input,
+            &mut coverage,
+            &mut signal,
+            &mut pure,
+            &mut stats,
+        )?;
+    }
+    stats.target_ns = t0.elapsed().as_nanos() as u64;
+
+    let t1 = Instant::now();
+    let mut earth_px = 0usize;
+    if let Some(earth) = &input.earth {
+        earth_px = render_earth(
+            &cam,
+            earth,
+            input.readout,
+            &coverage,
+            &mut signal,
+            &mut pure,
+            &mut stats,
+        )?;
+    }
+    stats.earth_ns = t1.elapsed().as_nanos() as u64;
+
+    let t2 = Instant::now();
+    let bits = input.camera.bits;
+    let mapping = match input.readout {
+        Readout::Detection(scale) => DnMapping::detection(scale, bits)?,
+        Readout::Radiometry => {
+            // Eq. 17 over the pure pixels, with the span kept at least
+            // MIN_RANGE_NETD NETDs wide (in F at the reference temperature), so a
+            // near-uniform scene is not stretched until its noise fills the frame.
+            let (lo, hi) = pure.bounds().unwrap_or((0.0, 0.0));
+            let min_span = MIN_RANGE_NETD
+                * input.camera.netd_k
+                * std::f64::consts::PI
+                * input
+                    .band
+                    .radiance_derivative_w_m2_sr_k(input.camera.netd_reference_k, 1.0)?;
+            let (lo, hi) = if hi - lo >= min_span && hi > lo {
+                (lo, hi)
+            } else {
+                let lo = (0.5 * (lo + hi) - 0.5 * min_span).max(0.0);
+                (lo, lo + min_span.max(f64::MIN_POSITIVE))
+            };
+            DnMapping::radiometry_auto(lo, hi, bits)?
+        }
+    };
+    let mut noise_sigma_dn = 0.0;
+    let mut field = match input.noise_seed {
+        None => None,
+        Some(seed) => {
+            let signal_per_radiance_sr = match input.readout {
+                Readout::Radiometry => std::f64::consts::PI,
+                Readout::Detection(_) => {
+                    SENSOR_AREA_M2 / input.earth_distance_m / input.earth_distance_m
+                }
+            };
+            let dn_per_k = mapping.dn_per_kelvin(
+                input.band,
+                input.camera.netd_reference_k,
+                signal_per_radiance_sr,
+            )?;
+            let level = NoiseLevel::Netd {
+                netd_k: input.camera.netd_k,
+                dn_per_k,
+            };
+            let sigmas = level.sigmas(&NoiseRms::TABLE2, &mapping)?;
+            noise_sigma_dn = sigmas.total_dn();
+            Some(NoiseField::new(
+                sigmas,
+                input.camera.flicker_correlation_px,
+                cam.w,
+                seed,
+            )?)
+        }
+    };
+    let mut dn = vec![0u16; n];
+    expose_frame(&signal, cam.w, &mapping, field.as_mut(), &mut dn)?;
+    stats.expose_ns = t2.elapsed().as_nanos() as u64;
+
+    let truth = mask_box(&coverage, cam.w);
+    Ok(Rendered {
+        width: cam.w,
+        height: cam.h,
+        dn,
+        signal,
+        coverage,
+        truth,
+        earth_fraction: earth_px as f64 / n as f64,
+        mapping,
+        noise_sigma_dn,
+        stats,
+    })
+}
+
+/// Image point of sub-sample `s` (0..16, row-major) of pixel (x, y): the centres of a
+/// 4 × 4 grid of equal cells.
+fn sample_point(x: usize, y: usize, s: usize) -> (f64, f64) {
+    let step = 1.0 / SUPERSAMPLES_PER_AXIS as f64;
+    (
+        x as f64 + ((s % SUPERSAMPLES_PER_AXIS) as f64 + 0.5) * step,
+        y as f64 + ((s / SUPERSAMPLES_PER_AXIS) as f64 + 0.5) * step,
+    )
+}
+
+/// Tight box of the pixels whose coverage is at least [`MASK_COVERAGE`].
+pub fn mask_box(coverage: &[f32], width: usize) -> Roi {
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for (y, row) in coverage.chunks_exact(width).enumerate() {
+        for (x, &c) in row.iter().enumerate() {
+            if c >= MASK_COVERAGE {
+                x0 = x0.min(x);
+                y0 = y0.min(y);
+                x1 = x1.max(x + 1);
+                y1 = y1.max(y + 1);
+            }
+        }
+    }
+    if x0 == usize::MAX {
+        Roi::EMPTY
+    } else {
+        Roi::new(x0 as u16, y0 as u16, x1 as u16, y1 as u16)
+    }
+}

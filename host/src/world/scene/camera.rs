@@ -1,0 +1,97 @@
+//! The camera of a scene (Table 4, Hayabusa2 TIR) and its read-out.
+
+use serde::{Deserialize, Serialize};
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
+
+/// The camera of Table 4 (Hayabusa2 TIR) and its read-out.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Camera {
+    /// Focal length, mm (Table 4: 42.2).
+    pub focal_length_mm: f64,
+    /// Pixel pitch, µm (Table 4: 37).
+    pub pixel_pitch_um: f64,
+    /// Columns, 1..=328 (Table 4: 328).
+    pub width: usize,
+    /// Rows, 1..=248 (Table 4: 248).
+    pub height: usize,
+    /// Bits per DN, 1..=16 (default 14).
+    pub bits: u8,
+    /// Noise-equivalent temperature difference the noise is scaled to, K (0.4, the TIR's).
+    pub netd_k: f64,
+    /// Scene temperature at which the NETD holds, K (300).
+    pub netd_reference_k: f64,
+    /// Correlation length of the 1/f noise map, pixels (4).
+    pub flicker_correlation_px: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            focal_length_mm: 42.2,
+            pixel_pitch_um: 37.0,
+            width: FRAME_WIDTH,
+            height: FRAME_HEIGHT,
+            bits: 14,
+            netd_k: TIR_NETD_K,
+            netd_reference_k: 300.0,
+            flicker_correlation_px: DEFAULT_FLICKER_CORRELATION_PX,
+        }
+    }
+}
+
+impl Camera {
+    /// Focal length in pixels (42.2 mm / 37 µm = 1 140.5 px).
+    pub fn focal_px(&self) -> f64 {
+        self.focal_length_mm * 1e3 / self.pixel_pitch_um
+    }
+
+    /// Full field of view (horizontal, vertical), degrees (16.4 × 12.4 for Table 4, which
+    /// rounds them to 16 × 12).
+    pub fn fov_deg(&self) -> (f64, f64) {
+        let f = self.focal_px();
+        let full = |n: usize| 2.0 * (n as f64 / 2.0 / f).atan().to_degrees();
+        (full(self.width), full(self.height))
+    }
+
+    /// Instantaneous field of view of one pixel, rad (0.877 mrad).
+    pub fn ifov_rad(&self) -> f64 {
+        1.0 / self.focal_px()
+    }
+
+    pub(super) fn validate(&self) -> Result<(), String> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("camera.{name} = {v}: expected a finite number > 0"))
+            }
+        };
+        positive("focal_length_mm", self.focal_length_mm)?;
+        positive("pixel_pitch_um", self.pixel_pitch_um)?;
+        positive("netd_reference_k", self.netd_reference_k)?;
+        if !(self.netd_k.is_finite() && self.netd_k >= 0.0) {
+            return Err(format!(
+                "camera.netd_k = {}: expected a number >= 0",
+                self.netd_k
+            ));
+        }
+        if !(self.flicker_correlation_px.is_finite() && self.flicker_correlation_px >= 0.0) {
+            return Err(format!(
+                "camera.flicker_correlation_px = {}: expected a number >= 0",
+                self.flicker_correlation_px
+            ));
+        }
+        if !(1..=FRAME_WIDTH).contains(&self.width) || !(1..=FRAME_HEIGHT).contains(&self.height) {
+            return Err(format!(
+                "camera.width × height = {} × {}: expected at most {FRAME_WIDTH} × {FRAME_HEIGHT} (the core's frame)",
+                self.width, self.height
+            ));
+        }
+        if !(1..=16).contains(&self.bits) {
+            return Err(format!("camera.bits = {}: expected 1..=16", self.bits));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,150 @@
+//! The choices a scene kind makes: camera mode, target model, illumination, and
+//! parameters drawn from a range or fixed.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// Camera mode (Section 3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Mode {
+    /// Radiometry: DN = a·F + b with F = D·q_fc (Eqs. 5–7), auto-ranged per frame (Eq. 17).
+    Radiometry,
+    /// Detection: DN = a·q_fc + b on a fixed scale of Table 5 (Eq. 9).
+    Detection,
+}
+
+impl Mode {
+    /// "radiometry" or "detection".
+    pub fn label(&self) -> &'static str {
+        match self {
+            Mode::Radiometry => "radiometry",
+            Mode::Detection => "detection",
+        }
+    }
+}
+
+/// Which spacecraft is the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TargetModel {
+    /// The paper's simplified target: a cube with a cylinder (Section 4.1).
+    CubeCylinder,
+    /// A Tango-like satellite (PRISMA, Section 5).
+    Tango,
+}
+
+impl TargetModel {
+    /// "cube-cylinder" or "tango".
+    pub fn label(&self) -> &'static str {
+        match self {
+            TargetModel::CubeCylinder => "cube-cylinder",
+            TargetModel::Tango => "tango",
+        }
+    }
+
+    /// Default facet edge length of the mesh, m: fine enough that a facet spans a few
+    /// pixels at the closest range (a pixel is 13 mm at 15 m).
+    pub fn default_resolution_m(&self) -> f64 {
+        match self {
+            TargetModel::CubeCylinder => 0.05,
+            TargetModel::Tango => 0.05,
+        }
+    }
+}
+
+/// Whether the Sun lights the target and the Earth (Section 3.2.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Illumination {
+    /// Sunlit: solar, albedo and Earth IR heat the target; the Earth map as measured.
+    Sunlit,
+    /// Eclipse: Earth IR only; the Earth's flux scaled by the diurnal factor.
+    Eclipse,
+}
+
+impl Illumination {
+    /// "sunlit" or "eclipse".
+    pub fn label(&self) -> &'static str {
+        match self {
+            Illumination::Sunlit => "sunlit",
+            Illumination::Eclipse => "eclipse",
+        }
+    }
+}
+
+/// A number fixed, or drawn uniformly from `[min, max]` per image.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "expected a number, or a table { min = <number>, max = <number> }"
+)]
+pub enum Param {
+    /// The same value for every image.
+    Fixed(f64),
+    /// Uniform in `[min, max]`.
+    Range {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+}
+
+impl Param {
+    /// The value for a uniform variate `u` in [0, 1).
+    pub fn sample(&self, u: f64) -> f64 {
+        match *self {
+            Param::Fixed(v) => v,
+            Param::Range { min, max } => min + (max - min) * u,
+        }
+    }
+
+    /// The smallest and largest value it can take.
+    pub fn bounds(&self) -> (f64, f64) {
+        match *self {
+            Param::Fixed(v) => (v, v),
+            Param::Range { min, max } => (min, max),
+        }
+    }
+
+    pub(super) fn validate(&self, field: &str, lo: f64, hi: f64) -> Result<(), String> {
+        let (a, b) = self.bounds();
+        if !(a.is_finite() && b.is_finite() && a <= b && a >= lo && b <= hi) {
+            return Err(format!(
+                "{field} = {self}: expected a value (or min <= max) within [{lo}, {hi}]"
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for Param {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Param::Fixed(v) => write!(f, "{v}"),
+            Param::Range { min, max } => write!(f, "{{ min = {min}, max = {max} }}"),
+        }
+    }
+}
+
+/// One value, or a list that consecutive poses cycle through.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, expecting = "not an accepted value")]
+pub enum OneOrMany<T> {
+    /// One value.
+    One(T),
+    /// Values taken in turn.
+    Many(Vec<T>),
+}
+
+impl<T: Copy> OneOrMany<T> {
+    /// The values as a slice-like list.
+    pub fn values(&self) -> Vec<T> {
+        match self {
+            OneOrMany::One(v) => vec![*v],
+            OneOrMany::Many(v) => v.clone(),
+        }
+    }
+}

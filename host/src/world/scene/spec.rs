@@ -1,0 +1,338 @@
+//! The Earth model, dataset settings and one scene kind ([`SceneSpec`]) of a scene file,
+//! with their serde defaults and checks.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+use tirroi_core::sensor::DetectionScale;
+
+use super::kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
+use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
+use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
+use crate::world::spacecraft::MaterialCase;
+
+/// Where the Earth's longwave flux map comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EarthSource {
+    /// The built-in synthetic daily field ([`crate::world::earth::OlrGrid::builtin`]).
+    Builtin,
+    /// A CERES SYN1deg NetCDF file (`path`, `variable`, `time_index`); needs the
+    /// `netcdf` cargo feature.
+    Netcdf,
+}
+
+/// The Earth model shared by every scene of a file (Section 3.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EarthModel {
+    /// Source of the 1° TOA longwave flux map.
+    pub source: EarthSource,
+    /// NetCDF file (relative paths are taken from the config file's directory).
+    pub path: Option<PathBuf>,
+    /// NetCDF variable (CERES SYN1deg daily all-sky TOA LW: `toa_lw_all_daily`).
+    pub variable: String,
+    /// Index along the file's time dimension (day).
+    pub time_index: usize,
+    /// Built-in source: how many different daily maps the images draw from (1..=16).
+    pub days: usize,
+    /// Cell size of the refined mesh, degrees (0.1 as the paper's Fig. 3b; 1.0 gives 3a).
+    pub mesh_deg: f64,
+    /// Eclipse: factor on the sunlit flux map (Section 3.2.2).
+    pub eclipse_factor: f32,
+    /// Earth radius, km.
+    pub radius_km: f64,
+}
+
+impl Default for EarthModel {
+    fn default() -> Self {
+        EarthModel {
+            source: EarthSource::Builtin,
+            path: None,
+            variable: "toa_lw_all_daily".into(),
+            time_index: 0,
+            days: 2,
+            mesh_deg: EarthMap::DEFAULT_MESH_DEG,
+            eclipse_factor: ECLIPSE_FLUX_FACTOR,
+            radius_km: EARTH_RADIUS_M / 1e3,
+        }
+    }
+}
+
+impl EarthModel {
+    pub(super) fn validate(&self) -> Result<(), String> {
+        if self.source == EarthSource::Netcdf && self.path.is_none() {
+            return Err(
+                "earth_model.path is missing: source = \"netcdf\" needs path = \"FILE.nc\"".into(),
+            );
+        }
+        if !(1..=16).contains(&self.days) {
+            return Err(format!("earth_model.days = {}: expected 1..=16", self.days));
+        }
+        if !(self.mesh_deg.is_finite() && self.mesh_deg > 0.0 && self.mesh_deg <= 1.0) {
+            return Err(format!(
+                "earth_model.mesh_deg = {}: expected a cell size in (0, 1] degrees that divides 1",
+                self.mesh_deg
+            ));
+        }
+        if !(self.eclipse_factor.is_finite()
+            && self.eclipse_factor > 0.0
+            && self.eclipse_factor <= 1.0)
+        {
+            return Err(format!(
+                "earth_model.eclipse_factor = {}: expected (0, 1]",
+                self.eclipse_factor
+            ));
+        }
+        if !(self.radius_km.is_finite() && self.radius_km > 0.0) {
+            return Err(format!(
+                "earth_model.radius_km = {}: expected a number > 0",
+                self.radius_km
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Dataset-wide settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DatasetSettings {
+    /// Name written into the labels.
+    pub name: String,
+    /// Master seed: every image's pose, Earth and noise derive from it and its index.
+    pub seed: u64,
+    /// Thermal states per (target, material, illumination): random-attitude images
+    /// pick one of these steady-state solutions and a camera view consistent with it.
+    pub thermal_states: usize,
+}
+
+impl Default for DatasetSettings {
+    fn default() -> Self {
+        DatasetSettings {
+            name: "custom".into(),
+            seed: 1,
+            thermal_states: 12,
+        }
+    }
+}
+
+/// One kind of scene: `count` images sharing these settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Label of this kind (default "scene-N").
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Images of this kind (detection: a multiple of the number of scales).
+    #[serde(default = "one")]
+    pub count: usize,
+    /// Camera mode.
+    #[serde(default = "radiometry")]
+    pub mode: Mode,
+    /// Detection scales of Table 5 (1, 2 or 3); each pose is rendered at every scale
+    /// listed, as in the paper. Ignored in radiometry mode.
+    #[serde(default = "scale_one")]
+    pub scale: OneOrMany<u8>,
+    /// Target spacecraft.
+    #[serde(default = "cube_cylinder")]
+    pub target: TargetModel,
+    /// Table 3 material case (cube + cylinder only).
+    #[serde(default = "mono")]
+    pub material: OneOrMany<MaterialCase>,
+    /// Facet edge length of the target mesh, m (default per target).
+    #[serde(default)]
+    pub resolution_m: Option<f64>,
+    /// Camera–target centre distance, m (0.5..=100 000).
+    pub range_m: Param,
+    /// Target attitude as Z-Y-X Euler angles, degrees, body → camera frame; omitted: a
+    /// random attitude consistent with one of the dataset's thermal states.
+    #[serde(default)]
+    pub attitude_deg: Option<[f64; 3]>,
+    /// Where the target's centre projects, pixels from the frame centre (x right, y
+    /// down); omitted: uniform within the central `max_offset_fraction` of the frame.
+    #[serde(default)]
+    pub offset_px: Option<[f64; 2]>,
+    /// Random offsets stay within this fraction of the half-frame (0..=1, default 0.6).
+    #[serde(default = "max_offset")]
+    pub max_offset_fraction: f64,
+    /// Sunlit or eclipse (one, or a list the poses cycle through).
+    #[serde(default = "sunlit")]
+    pub illumination: OneOrMany<Illumination>,
+    /// Direction to the Sun in the camera frame (with a fixed attitude only; default
+    /// from behind the camera's upper left).
+    #[serde(default)]
+    pub sun_dir: Option<[f64; 3]>,
+    /// Add the camera noise (Eq. 18).
+    #[serde(default = "yes")]
+    pub noise: bool,
+    /// Render the Earth (false: deep space behind the target; the Earth still heats it).
+    #[serde(default = "yes")]
+    pub earth: bool,
+    /// Camera–Earth centre distance, km (10 871: 4 500 km altitude, Section 4.1).
+    #[serde(default = "earth_distance")]
+    pub earth_distance_km: f64,
+    /// Angle between the boresight and the direction to the Earth's centre, degrees
+    /// (below ~26° the Earth fills the frame, above ~46° it is out of view).
+    #[serde(default = "off_boresight")]
+    pub earth_off_boresight_deg: Param,
+    /// Image-plane direction towards the Earth's centre, degrees from +x towards +y.
+    #[serde(default = "full_circle")]
+    pub earth_azimuth_deg: Param,
+}
+
+fn one() -> usize {
+    1
+}
+fn radiometry() -> Mode {
+    Mode::Radiometry
+}
+fn scale_one() -> OneOrMany<u8> {
+    OneOrMany::One(1)
+}
+fn cube_cylinder() -> TargetModel {
+    TargetModel::CubeCylinder
+}
+fn mono() -> OneOrMany<MaterialCase> {
+    OneOrMany::One(MaterialCase::Mono)
+}
+fn max_offset() -> f64 {
+    0.6
+}
+fn sunlit() -> OneOrMany<Illumination> {
+    OneOrMany::One(Illumination::Sunlit)
+}
+fn yes() -> bool {
+    true
+}
+fn earth_distance() -> f64 {
+    EARTH_DISTANCE_M / 1e3
+}
+fn off_boresight() -> Param {
+    Param::Range {
+        min: 0.0,
+        max: 60.0,
+    }
+}
+fn full_circle() -> Param {
+    Param::Range {
+        min: 0.0,
+        max: 360.0,
+    }
+}
+
+impl SceneSpec {
+    /// The detection scales of this kind (one entry, unused, for radiometry).
+    pub fn scales(&self) -> Vec<DetectionScale> {
+        match self.mode {
+            Mode::Radiometry => vec![DetectionScale::Scale1],
+            Mode::Detection => self
+                .scale
+                .values()
+                .into_iter()
+                .map(|s| match s {
+                    2 => DetectionScale::Scale2,
+                    3 => DetectionScale::Scale3,
+                    _ => DetectionScale::Scale1,
+                })
+                .collect(),
+        }
+    }
+
+    /// Mesh facet size, m.
+    pub fn resolution(&self) -> f64 {
+        self.resolution_m
+            .unwrap_or_else(|| self.target.default_resolution_m())
+    }
+
+    pub(super) fn validate(&self, at: &str, earth_radius_km: f64) -> Result<(), String> {
+        if self.count == 0 {
+            return Err(format!("{at}.count = 0: expected at least 1 image"));
+        }
+        if self.count > 1_000_000 {
+            return Err(format!(
+                "{at}.count = {}: expected at most 1 000 000",
+                self.count
+            ));
+        }
+        let scales = self.scale.values();
+        if scales.is_empty() || scales.iter().any(|s| !(1..=3).contains(s)) {
+            return Err(format!(
+                "{at}.scale = {scales:?}: expected 1, 2 or 3 (Table 5), or a non-empty list of them"
+            ));
+        }
+        if self.mode == Mode::Detection && self.count % scales.len() != 0 {
+            return Err(format!(
+                "{at}.count = {}: expected a multiple of the {} scales (each pose is rendered at every scale)",
+                self.count,
+                scales.len()
+            ));
+        }
+        if self.material.values().is_empty() {
+            return Err(format!(
+                "{at}.material: expected at least one material case"
+            ));
+        }
+        if self.illumination.values().is_empty() {
+            return Err(format!(
+                "{at}.illumination: expected at least one of \"sunlit\", \"eclipse\""
+            ));
+        }
+        if let Some(r) = self.resolution_m {
+            if !(r.is_finite() && (0.005..=1.0).contains(&r)) {
+                return Err(format!(
+                    "{at}.resolution_m = {r}: expected a facet size in [0.005, 1] m"
+                ));
+            }
+        }
+        self.range_m.validate(&format!("{at}.range_m"), 0.5, 1e5)?;
+        if let Some(a) = self.attitude_deg {
+            if a.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{at}.attitude_deg = {a:?}: expected three finite angles"
+                ));
+            }
+        }
+        if let Some(o) = self.offset_px {
+            if o.iter().any(|v| !v.is_finite() || v.abs() > 1e4) {
+                return Err(format!(
+                    "{at}.offset_px = {o:?}: expected two finite pixel offsets"
+                ));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.max_offset_fraction) {
+            return Err(format!(
+                "{at}.max_offset_fraction = {}: expected 0..=1",
+                self.max_offset_fraction
+            ));
+        }
+        if let Some(s) = self.sun_dir {
+            if s.iter().any(|v| !v.is_finite()) || s.iter().all(|v| *v == 0.0) {
+                return Err(format!(
+                    "{at}.sun_dir = {s:?}: expected a finite non-zero vector"
+                ));
+            }
+            if self.attitude_deg.is_none() {
+                return Err(format!(
+                    "{at}.sun_dir needs attitude_deg: a random attitude takes the Sun from its thermal state"
+                ));
+            }
+        }
+        if !(self.earth_distance_km.is_finite()
+            && self.earth_distance_km > earth_radius_km * 1.0001)
+        {
+            return Err(format!(
+                "{at}.earth_distance_km = {}: expected more than the Earth's radius ({earth_radius_km} km)",
+                self.earth_distance_km
+            ));
+        }
+        self.earth_off_boresight_deg.validate(
+            &format!("{at}.earth_off_boresight_deg"),
+            0.0,
+            180.0,
+        )?;
+        self.earth_azimuth_deg
+            .validate(&format!("{at}.earth_azimuth_deg"), -360.0, 720.0)?;
+        Ok(())
+    }
+}

@@ -1,0 +1,59 @@
+//! Unit tests of scene files and presets.
+
+use super::*;
+
+#[test]
+fn table4_camera() {
+    let c = Camera::default();
+    assert!((c.focal_px() - 1140.54).abs() < 0.01);
+    let (h, v) = c.fov_deg();
+    assert!(
+        (h - 16.36).abs() < 0.01 && (v - 12.41).abs() < 0.01,
+        "{h} {v}"
+    );
+    assert!((c.ifov_rad() - 8.768e-4).abs() < 1e-6);
+}
+
+#[test]
+fn presets_parse() {
+    for (name, _, _) in PRESETS {
+        let f = SceneFile::preset(name).unwrap();
+        assert!(f.image_count() > 0);
+    }
+    assert_eq!(SceneFile::preset("paper").unwrap().image_count(), 12_000);
+    assert_eq!(SceneFile::preset("tango").unwrap().image_count(), 1_000);
+    assert!(SceneFile::preset("nope").is_err());
+    let mut paper = SceneFile::preset("paper").unwrap();
+    paper.rescale_count(120).unwrap();
+    assert_eq!(paper.image_count(), 120);
+    assert!(paper.scenes.iter().all(|s| s.count == 30));
+    paper.rescale_count(1).unwrap();
+    assert_eq!(paper.image_count(), 1 + 1 + 3 + 3);
+}
+
+#[test]
+fn errors_name_line_and_field() {
+    let e = SceneFile::parse("[[scene]]\nrange_m = 20.0\nrnage = 3\n", "x.toml").unwrap_err();
+    assert_eq!(e.line_col.map(|l| l.0), Some(3), "{e}");
+    assert!(e.to_string().contains("rnage"), "{e}");
+    let e = SceneFile::parse("[[scene]]\nrange_m = \"far\"\n", "x.toml").unwrap_err();
+    assert!(e.to_string().contains("x.toml:2:"), "{e}");
+    assert!(e.to_string().contains("a number, or a table"), "{e}");
+    assert!(e.to_string().contains("`range_m`"), "{e}");
+    let e = SceneFile::parse("[[scene]]\nrange_m = { min = 50.0, max = 15.0 }\n", "x").unwrap_err();
+    assert!(e.to_string().contains("scene[0].range_m"), "{e}");
+    let e = SceneFile::parse("[[scene]]\nrange_m = 20.0\nmaterial = \"gold\"\n", "x").unwrap_err();
+    assert!(e.to_string().contains("x:3:"), "{e}");
+    assert!(e.to_string().contains("`material`"), "{e}");
+    assert!(e.to_string().contains("\"multi-1\""), "{e}");
+    let e = SceneFile::parse(
+        "[[scene]]\nrange_m = 20.0\nmode = \"detection\"\nscale = [1, 2]\ncount = 3\n",
+        "x",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("multiple of the 2 scales"), "{e}");
+    let e =
+        SceneFile::parse("[camera]\nwidth = 640\n[[scene]]\nrange_m = 20.0\n", "x").unwrap_err();
+    assert!(e.to_string().contains("camera.width"), "{e}");
+    assert!(SceneFile::parse("", "x").is_err());
+}
