@@ -54,15 +54,11 @@
 //! fuzz target check it); memory [`SCRATCH_BYTES`] (≤ 32 KiB, checked at compile
 //! time).
 
-use super::plane::{BLOCK, Window};
+use super::plane::{BLOCK, PLANE_CELLS, PLANE_WIDTH, Window};
 use super::{BoxRule, DetectError, Detection, Detector, Roi, RoiBuilder, Scratch};
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
 
-/// Width of the block-mean plane, in cells (82 for 328 pixels).
-pub const GRID_WIDTH: usize = FRAME_WIDTH.div_ceil(BLOCK);
-/// Height of the block-mean plane, in cells (62 for 248 pixels).
-pub const GRID_HEIGHT: usize = FRAME_HEIGHT.div_ceil(BLOCK);
-const GRID: usize = GRID_WIDTH * GRID_HEIGHT;
+const GRID: usize = PLANE_CELLS;
 /// Most edge components labelled per frame; edge cells that would start a further
 /// component are dropped (a frame that noisy has no outline worth boxing).
 pub const MAX_COMPONENTS: usize = 250;
@@ -738,7 +734,7 @@ impl Auto {
         row_sat.fill(0);
         // Runs of gated cells of a cell row as pixel ranges relative to rx0 (set for
         // each cell row): the counts touch gated pixels only, a slice per run.
-        let mut runs = [(0u16, 0u16); GRID_WIDTH / 2 + 1];
+        let mut runs = [(0u16, 0u16); PLANE_WIDTH / 2 + 1];
         let (mut n_runs, mut runs_row) = (0, usize::MAX);
         for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
             let Some(row) = frame.row(y) else { continue };
