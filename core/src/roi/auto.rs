@@ -15,7 +15,7 @@
 //!    its right or two below, in units of σ/4, as an 8-bit logarithmic code (16 codes
 //!    per octave; a plane of 82×62 cells). The target's outline is a step; the
 //!    Earth's texture is a ramp and the noise small.
-//! 3. **Candidates.** Cells with a step of at least `coarse_k · σ` are edge cells,
+//! 3. **Candidates.** Cells with a step of at least `coarse_sigma · σ` are edge cells,
 //!    labelled into 8-connected components (at most [`MAX_COMPONENTS`]; a frame with
 //!    more is labelled again with a threshold half as high again), each with its cell
 //!    box and summed steps (linear, so a saturated target's outline outweighs a wide
@@ -25,13 +25,13 @@
 //!    border) and Earth patches cut by the frame lose to a compact outline inside it.
 //! 5. **Refinement.** At full resolution inside the winner's cell box plus one cell,
 //!    only at pixels whose cell neighbours the winner: a step of at least
-//!    `fine_k · σ` between pixels `x − 1` and `x + 1`, the largest along its direction
+//!    `fine_sigma · σ` between pixels `x − 1` and `x + 1`, the largest along its direction
 //!    (which drops the small step between a partly covered pixel and the background
 //!    beyond it), is a boundary before `x` when `x` resembles `x + 1`, else after it.
 //!    With labels of pixels at least half covered (our truth), that is the truth's
 //!    boundary for any contrast and polarity. The box spans the outermost boundaries.
 //!    In clean deep space (sunlit frames: 0 DN nearly everywhere, clipped noise a
-//!    sparse sprinkle), a step from 0 DN below `fine_k · σ` also counts when the pixel
+//!    sparse sprinkle), a step from 0 DN below `fine_sigma · σ` also counts when the pixel
 //!    beyond it and its four neighbours are above 0: a faint (cold) face.
 //! 6. **Saturated target** (detection mode, recognised by pixels at the top DN with
 //!    hardly any just below it, unlike a radiometry face at the top DN with noise):
@@ -75,11 +75,11 @@ pub struct Auto {
     /// Any box is accepted; it is cut to the frame, and an empty result means no prior.
     pub prior: Option<Roi>,
     /// Coarse edge threshold: a cell is an edge cell when its largest step reaches
-    /// `coarse_k · σ` (σ: the pixel noise, DN): 1..=1000. Default 6.
-    pub coarse_k: u16,
+    /// `coarse_sigma · σ` (σ: the pixel noise, DN): 1..=1000. Default 6.
+    pub coarse_sigma: u16,
     /// Full-resolution boundary threshold: a step over two pixels counts when it
-    /// reaches `fine_k · σ` (twice that beside a saturated target): 1..=1000. Default 8.
-    pub fine_k: u16,
+    /// reaches `fine_sigma · σ` (twice that beside a saturated target): 1..=1000. Default 8.
+    pub fine_sigma: u16,
     /// Tracking window margin around the prior, in pixels: 0..=328. Default 16 (plus
     /// `max(width, height) / 8`: room for a move of several pixels and a 10 % change of
     /// size per frame).
@@ -90,8 +90,8 @@ impl Default for Auto {
     fn default() -> Self {
         Auto {
             prior: None,
-            coarse_k: 6,
-            fine_k: 8,
+            coarse_sigma: 6,
+            fine_sigma: 8,
             margin_px: 16,
         }
     }
@@ -626,12 +626,12 @@ impl Auto {
         } = work;
         let label = &mut label[..pw * ph];
         let step = &mut step[..pw * ph];
-        // Edge cells (step ≥ coarse_k·σ), labelled in raster order (8-connected,
+        // Edge cells (step ≥ coarse_sigma·σ), labelled in raster order (8-connected,
         // union-find on u8 labels, statistics merged on union). A frame with more
         // components than labels (noise, texture) is labelled again with a threshold
         // half as high again, up to four times; so no cell below the first threshold's
         // code is ever an edge cell.
-        let mut threshold = step_code(u32::from(self.coarse_k) * 4);
+        let mut threshold = step_code(u32::from(self.coarse_sigma) * 4);
         step_plane(frame, win, sigma, step_value(threshold), pw, steps, step);
 
         let mut next = None;
@@ -720,7 +720,7 @@ impl Auto {
         let gate = &*label;
         let gated =
             |x: usize, y: usize| gate[(y - win.y0) / BLOCK * pw + (x - win.x0) / BLOCK] != 0;
-        let tau = (u32::from(self.fine_k) * sigma).min(u32::from(u16::MAX)) as u16;
+        let tau = (u32::from(self.fine_sigma) * sigma).min(u32::from(u16::MAX)) as u16;
         // Beside a saturated target the frame is nearly noise-free and the boundaries
         // that matter are of cold, unsaturated faces: twice the threshold.
         let tau_unsat = tau.saturating_mul(2);
@@ -961,7 +961,7 @@ impl Auto {
         };
         roi.map(|roi| Found {
             roi: Some(roi),
-            threshold: u32::from(self.coarse_k) * sigma,
+            threshold: u32::from(self.coarse_sigma) * sigma,
             edge_px,
         })
     }
@@ -1026,15 +1026,15 @@ impl Detector for Auto {
     const NAME: &'static str = "auto";
 
     fn validate(&self) -> Result<(), DetectError> {
-        if !(1..=1000).contains(&self.coarse_k) {
+        if !(1..=1000).contains(&self.coarse_sigma) {
             return Err(DetectError::InvalidParameter {
-                name: "coarse_k",
+                name: "coarse_sigma",
                 expected: "1..=1000 (units of the block-mean noise)",
             });
         }
-        if !(1..=1000).contains(&self.fine_k) {
+        if !(1..=1000).contains(&self.fine_sigma) {
             return Err(DetectError::InvalidParameter {
-                name: "fine_k",
+                name: "fine_sigma",
                 expected: "1..=1000 (units of the pixel noise)",
             });
         }
