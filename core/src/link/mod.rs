@@ -108,7 +108,7 @@ pub use wire::{
 #[cfg(test)]
 mod tests {
     use super::camera::FAULT_WORDS;
-    use super::wire::{CRC16, check_reply, header};
+    use super::wire::{CRC16, check_reply};
     use super::*;
 
     #[test]
