@@ -16,6 +16,7 @@
 //! No detector allocates, and none panics on any frame a [`Frame`] can hold.
 
 mod bbox;
+mod components;
 mod mask;
 mod plane;
 
