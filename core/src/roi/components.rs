@@ -139,7 +139,6 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
 
     /// Points every label of `labels` straight at its root, so later lookups are one
     /// read of [`Components::parents`].
-    #[allow(dead_code)] // used by auto (next commit)
     pub fn flatten(&mut self, labels: core::ops::Range<usize>, label: impl Fn(usize) -> L) {
         for l in labels {
             let root = self.find(label(l));
