@@ -428,6 +428,47 @@ mod tests {
     }
 
     #[test]
+    fn tunable_numbers_default_to_the_rule_and_are_bounded() {
+        use super::{Auto, Detector};
+        let d = Auto::default();
+        assert_eq!((d.margin_divisor, d.side_shift, d.relabel_codes), (8, 3, 9));
+        assert_eq!((d.near_sat_sigma, d.sat_ratio), (4, 8));
+        assert!(d.validate().is_ok());
+        let bad = [
+            Auto {
+                margin_divisor: 0,
+                ..d
+            },
+            Auto {
+                side_shift: 16,
+                ..d
+            },
+            Auto {
+                relabel_codes: 0,
+                ..d
+            },
+            Auto {
+                near_sat_sigma: 65,
+                ..d
+            },
+            Auto { sat_ratio: 0, ..d },
+        ];
+        let names = [
+            "margin_divisor",
+            "side_shift",
+            "relabel_codes",
+            "near_sat_sigma",
+            "sat_ratio",
+        ];
+        for (a, name) in bad.iter().zip(names) {
+            match a.validate() {
+                Err(super::DetectError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+                Ok(()) => panic!("{name} accepted"),
+            }
+        }
+    }
+
+    #[test]
     fn noise_bins_round_trip() {
         for d in [0u32, 1, 15, 16, 17, 31, 32, 100, 1000, 16383, 65535] {
             let b = noise_bin(d);
