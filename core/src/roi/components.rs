@@ -22,14 +22,12 @@ pub(crate) trait Label: Copy + Eq + Ord {
 }
 
 impl Label for u8 {
-    #[inline(always)]
     fn index(self) -> usize {
         usize::from(self)
     }
 }
 
 impl Label for u16 {
-    #[inline(always)]
     fn index(self) -> usize {
         usize::from(self)
     }
@@ -62,19 +60,16 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
     }
 
     /// The parent of `l` (`None` outside the table).
-    #[inline(always)]
     pub fn parent(&self, l: usize) -> Option<L> {
         self.parent.get(l).copied()
     }
 
     /// The parent table.
-    #[inline(always)]
     pub fn parents(&self) -> &[L; P] {
         &self.parent
     }
 
     /// Sets the parent of `l` (ignored outside the table).
-    #[inline(always)]
     pub fn set_parent(&mut self, l: usize, p: L) {
         if let Some(e) = self.parent.get_mut(l) {
             *e = p;
@@ -82,19 +77,16 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
     }
 
     /// The statistics of `l` (`None` outside the table).
-    #[inline(always)]
     pub fn stats(&self, l: usize) -> Option<&S> {
         self.stats.get(l)
     }
 
     /// The statistics of `l`, to update (`None` outside the table).
-    #[inline(always)]
     pub fn stats_mut(&mut self, l: usize) -> Option<&mut S> {
         self.stats.get_mut(l)
     }
 
     /// Makes `l` a new root with statistics `stats`.
-    #[inline(always)]
     pub fn make_set(&mut self, l: L, stats: S) {
         self.set_parent(l.index(), l);
         if let Some(s) = self.stats.get_mut(l.index()) {
@@ -105,7 +97,6 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
     /// The root of `l`, halving the path on the way (every label on it then points to
     /// its grandparent). A label whose parent lies outside the table (a free entry) is
     /// its own root.
-    #[inline(always)]
     pub fn find(&mut self, mut l: L) -> L {
         loop {
             let Some(&p) = self.parent.get(l.index()) else {
@@ -124,7 +115,6 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
 
     /// Joins roots `a` and `b`: the lower label stays root and takes the other's
     /// statistics. Returns the root.
-    #[inline(always)]
     pub fn union(&mut self, a: L, b: L) -> L {
         if a == b {
             return a;
