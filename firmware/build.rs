@@ -10,8 +10,11 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-const WIDTH: u32 = 328;
-const HEIGHT: u32 = 248;
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+
+/// The core's frame size (the frames are embedded for its detectors).
+const WIDTH: u32 = FRAME_WIDTH as u32;
+const HEIGHT: u32 = FRAME_HEIGHT as u32;
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));

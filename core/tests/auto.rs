@@ -228,17 +228,17 @@ fn bad_parameters_are_errors() {
     let bad = [
         (
             Auto {
-                coarse_k: 0,
+                coarse_sigma: 0,
                 ..Auto::default()
             },
-            "coarse_k",
+            "coarse_sigma",
         ),
         (
             Auto {
-                fine_k: 1001,
+                fine_sigma: 1001,
                 ..Auto::default()
             },
-            "fine_k",
+            "fine_sigma",
         ),
         (
             Auto {
@@ -291,15 +291,15 @@ proptest! {
     fn any_frame_and_prior_gives_a_box_inside_the_frame(
         (w, h, bits, px) in arb_frame(),
         prior in prop::option::of((0u16..400, 0u16..300, 0u16..400, 0u16..300)),
-        coarse_k in 1u16..=40,
-        fine_k in 1u16..=40,
+        coarse_sigma in 1u16..=40,
+        fine_sigma in 1u16..=40,
     ) {
         let f = Frame::new(&px, w, h, bits).unwrap();
         let mut s = AutoScratch::new();
         let a = Auto {
             prior: prior.map(|(a, b, c, d)| Roi::new(a, b, c, d)),
-            coarse_k,
-            fine_k,
+            coarse_sigma,
+            fine_sigma,
             ..Auto::default()
         };
         let d = a.detect(&f, &mut s).unwrap();

@@ -21,8 +21,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Pixels per frame (328 × 248).
-const PIXELS: f64 = 81_344.0;
+use tirroi_core::frame::FRAME_PIXELS;
+
+/// Pixels per frame (the core's frame size).
+const PIXELS: f64 = FRAME_PIXELS as f64;
 /// Clock of the rad-tolerant Cortex-M7 the time estimate is for, Hz.
 const CLOCK_HZ: f64 = 100e6;
 

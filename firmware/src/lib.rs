@@ -24,15 +24,16 @@ pub mod synth;
 
 use core::hint::black_box;
 
-use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
 use tirroi_core::link::{FrameReader, SimulatedCamera};
 use tirroi_core::{Frame, Method};
 
 pub use detectors::{DEMO_METHODS, Detectors};
 pub use report::{Event, MeterReading};
 
-/// Bit depth of every frame of the demo (the renderer's and the camera's).
-pub const BITS: u8 = 14;
+/// Bit depth of every frame of the demo (the renderer's and the camera's): the core's
+/// default.
+pub const BITS: u8 = DEFAULT_BIT_DEPTH;
 
 /// The embedded frame whose row [`RETRY_ROW`] the simulated camera corrupts once, so
 /// the link has to re-request it.
@@ -173,7 +174,7 @@ fn detect_all<M: Meter>(
         Err(_) => {
             emit(&Event::Error {
                 frame: name,
-                what: "frame does not fit 14 bits",
+                what: "frame does not fit the bit depth",
             });
             return;
         }

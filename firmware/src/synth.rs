@@ -11,6 +11,7 @@
 
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::sensor::noise::NoiseRms;
+use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
 use tirroi_core::sensor::{
     BandLut, BandRadiance, DnMapping, NoiseField, NoiseLevel, SensorError, expose_frame,
 };
@@ -41,11 +42,11 @@ pub const NAME: &str = "on-board-sensor";
 /// Noise seed of the synthetic frame.
 pub const SEED: u64 = 2026;
 
-/// NETD of the camera, K (the TIR's 0.4 K at 300 K).
-pub const NETD_K: f64 = 0.4;
+/// NETD of the camera, K (the TIR's, from the core's noise model).
+pub const NETD_K: f64 = TIR_NETD_K;
 
-/// Correlation length of the 1/f noise map, px.
-pub const FLICKER_CORRELATION_PX: f32 = 4.0;
+/// Correlation length of the 1/f noise map, px (the core's default).
+pub const FLICKER_CORRELATION_PX: f32 = DEFAULT_FLICKER_CORRELATION_PX;
 
 /// Coldest and warmest (T, ε) of the scene: they set the Eq. 17 range.
 const COLDEST: (f32, f32) = (250.0, 0.95);

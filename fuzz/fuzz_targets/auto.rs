@@ -3,7 +3,7 @@
 //!
 //! Input layout: byte 0 width − 1 (mod 328), byte 1 height − 1 (mod 248), byte 2 bit
 //! depth − 1 (mod 16), byte 3 flags (bit 0: a prior is given), bytes 4..12 the prior
-//! `x0, y0, x1, y1` (little-endian u16), bytes 12 and 13 `coarse_k` and `fine_k`
+//! `x0, y0, x1, y1` (little-endian u16), bytes 12 and 13 `coarse_sigma` and `fine_sigma`
 //! (mod 40, + 1), the rest the DN (little-endian u16, repeated to fill the frame; none:
 //! a black frame).
 #![no_main]
@@ -23,8 +23,8 @@ fuzz_target!(|data: &[u8]| {
     let prior = (data[3] & 1 == 1).then(|| Roi::new(word(4), word(6), word(8), word(10)));
     let auto = Auto {
         prior,
-        coarse_k: 1 + u16::from(data[12] % 40),
-        fine_k: 1 + u16::from(data[13] % 40),
+        coarse_sigma: 1 + u16::from(data[12] % 40),
+        fine_sigma: 1 + u16::from(data[13] % 40),
         ..Auto::default()
     };
     let dn: Vec<u16> = data[14..]

@@ -24,17 +24,14 @@
 //! Memory is six 82×62 `u16` planes (base, blur temporary, four levels) plus the blob
 //! list and the mask-to-box state: see [`SCRATCH_BYTES`].
 
-use super::plane::{BLOCK, Window, block_means};
+use super::plane::{BLOCK, PLANE_CELLS, Window, block_means};
+pub use super::plane::{PLANE_HEIGHT, PLANE_WIDTH};
 use super::{BoxRule, DetectError, Detector, Scratch};
-use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
+use crate::frame::{FRAME_WIDTH, Frame};
 
 /// Block side of the downsampling, in pixels.
 pub const DOWNSAMPLE: usize = BLOCK;
-/// Width of the downsampled plane (82 for 328 pixels).
-pub const PLANE_WIDTH: usize = FRAME_WIDTH.div_ceil(DOWNSAMPLE);
-/// Height of the downsampled plane (62 for 248 pixels).
-pub const PLANE_HEIGHT: usize = FRAME_HEIGHT.div_ceil(DOWNSAMPLE);
-const PLANE: usize = PLANE_WIDTH * PLANE_HEIGHT;
+const PLANE: usize = PLANE_CELLS;
 const HALF_PLANE: usize = PLANE_WIDTH.div_ceil(2) * PLANE_HEIGHT.div_ceil(2);
 /// Levels with σ of at least this many plane pixels are blurred on the half plane
 /// and brought back bilinearly: a fraction of the cost, for Gaussians far wider than

@@ -16,6 +16,7 @@
 //! No detector allocates, and none panics on any frame a [`Frame`] can hold.
 
 mod bbox;
+mod components;
 mod mask;
 mod plane;
 pub mod registry;
@@ -80,7 +81,8 @@ pub struct Detection {
     pub roi: Option<Roi>,
     /// The threshold the detector used; its unit depends on the detector (DN for Otsu,
     /// DN offset for adaptive, Prewitt L1 gradient for WGE, scale-normalised DoG
-    /// response in DN for DoG). See each detector's `detect` documentation.
+    /// response in DN for DoG, the coarse edge threshold `coarse_sigma · σ` in DN of
+    /// a step over two pixels for auto). See each detector's `detect` documentation.
     pub threshold: u32,
     /// Number of foreground pixels in the mask (before the [`BoxRule`]).
     pub foreground_px: u32,

@@ -23,7 +23,7 @@
 //! | wge | `drop_fraction` × `min_gradient` (Prewitt L1 DN) | {0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 0.995, 0.998} × {0, 48, 128, 256, 512, 1024, 2048, 4096, 8192} |
 //! | dog | `sigma0_px` × `levels` × `min_response_dn` (`sigma_ratio` 1.6) | {2, 4, 8} × {3, 5, 7} × {64, 128, 256, 512, 1024, 2048} (the 6 sets whose widest σ exceeds the core's bound skipped) |
 //!
-//! | auto | `coarse_k` × `fine_k` (noise units; no box rule) | {6, 8, 10, 12, 16} × {6, 8, 12, 16} |
+//! | auto | `coarse_sigma` × `fine_sigma` (noise units; no box rule) | {6, 8, 10, 12, 16} × {6, 8, 12, 16} |
 //!
 //! That is 2 + 126 + 144 + 96 (+ 12 for auto) grid sets; the refinement adds some 20–150 trials per
 //! method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
@@ -38,8 +38,8 @@ mod search;
 mod tests;
 
 pub use params::{
-    AUTO_K_LADDER, BLOCK_LADDER, DROP_LADDER, GRADIENT_LADDER, OFFSET_LADDER, Params, RATIO_LADDER,
-    RESPONSE_LADDER, SIGMA0_LADDER, box_rule_name, grid,
+    AUTO_SIGMA_LADDER, BLOCK_LADDER, DROP_LADDER, GRADIENT_LADDER, OFFSET_LADDER, Params,
+    RATIO_LADDER, RESPONSE_LADDER, SIGMA0_LADDER, box_rule_name, grid,
 };
 pub use search::{
     MethodBest, SearchOptions, Trial, TuneResult, evaluate, evaluate_together, search,

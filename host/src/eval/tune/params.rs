@@ -137,8 +137,8 @@ impl Params {
                 p.sigma0_px, p.sigma_ratio, p.levels, p.min_response_dn
             ),
             Params::Auto(p) => format!(
-                "coarse_k={} fine_k={} margin_px={}",
-                p.coarse_k, p.fine_k, p.margin_px
+                "coarse_sigma={} fine_sigma={} margin_px={}",
+                p.coarse_sigma, p.fine_sigma, p.margin_px
             ),
         }
     }
@@ -188,11 +188,11 @@ impl Params {
                 }
             }
             Params::Auto(p) => {
-                for coarse_k in steps(&AUTO_K_LADDER, p.coarse_k) {
-                    out.push(Params::Auto(Auto { coarse_k, ..p }));
+                for coarse_sigma in steps(&AUTO_SIGMA_LADDER, p.coarse_sigma) {
+                    out.push(Params::Auto(Auto { coarse_sigma, ..p }));
                 }
-                for fine_k in steps(&AUTO_K_LADDER, p.fine_k) {
-                    out.push(Params::Auto(Auto { fine_k, ..p }));
+                for fine_sigma in steps(&AUTO_SIGMA_LADDER, p.fine_sigma) {
+                    out.push(Params::Auto(Auto { fine_sigma, ..p }));
                 }
             }
         }
@@ -237,8 +237,8 @@ pub const RESPONSE_LADDER: [u32; 17] = [
     16, 32, 48, 64, 96, 128, 192, 256, 384, 512, 768, 1024, 1536, 2048, 3072, 4096, 6144,
 ];
 
-/// Refinement ladder of `auto`'s `coarse_k` and `fine_k` (noise units).
-pub const AUTO_K_LADDER: [u16; 11] = [3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32];
+/// Refinement ladder of `auto`'s `coarse_sigma` and `fine_sigma` (noise units).
+pub const AUTO_SIGMA_LADDER: [u16; 11] = [3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32];
 
 /// The candidate grid of `method` (see the module documentation): every set of the
 /// grid with the largest-component rule, then every set with the all-foreground rule;
@@ -270,11 +270,11 @@ pub fn grid(method: Method) -> Vec<Params> {
             }
         }
         Method::Auto => {
-            for coarse_k in [6, 8, 10, 12, 16] {
-                for fine_k in [6, 8, 12, 16] {
+            for coarse_sigma in [6, 8, 10, 12, 16] {
+                for fine_sigma in [6, 8, 12, 16] {
                     base.push(Params::Auto(Auto {
-                        coarse_k,
-                        fine_k,
+                        coarse_sigma,
+                        fine_sigma,
                         ..Auto::default()
                     }));
                 }

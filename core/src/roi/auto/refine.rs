@@ -1,0 +1,504 @@
+//! Stages 5 and 6, refinement at full resolution: the gate (the winner's cells and
+//! their neighbours), saturation counts, the outermost boundaries, and a saturated
+//! target's box.
+
+use super::super::Roi;
+use super::super::plane::{BLOCK, PLANE_WIDTH, Window};
+use super::edges::{CellStats, EdgeComponents};
+use super::noise::Noise;
+use super::rules::{GATE_CELLS, SATURATED_TAU_FACTOR, TRIM_LINE_PX, TRIM_PASSES};
+use crate::frame::Frame;
+
+/// The refinement window: the winner's cell box grown by [`GATE_CELLS`], in frame
+/// pixels (exclusive ends) and in cells of the plane (`ca..cb`, `ra..rb`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Region {
+    pub rx0: usize,
+    pub ry0: usize,
+    pub rx1: usize,
+    pub ry1: usize,
+    pub ca: usize,
+    pub cb: usize,
+    pub ra: usize,
+    pub rb: usize,
+}
+
+impl Region {
+    /// The region of the winner `c` of the plane of `win`.
+    pub fn around(c: &CellStats, win: Window) -> Region {
+        let cell_px = |cell: u8| usize::from(cell) * BLOCK;
+        let rx0 = win.x0 + cell_px(c.x0.saturating_sub(GATE_CELLS));
+        let ry0 = win.y0 + cell_px(c.y0.saturating_sub(GATE_CELLS));
+        let rx1 = (win.x0 + cell_px(c.x1.saturating_add(GATE_CELLS))).min(win.x0 + win.w);
+        let ry1 = (win.y0 + cell_px(c.y1.saturating_add(GATE_CELLS))).min(win.y0 + win.h);
+        let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
+        let (ra, rb) = ((ry0 - win.y0) / BLOCK, (ry1 - 1 - win.y0) / BLOCK + 1);
+        Region {
+            rx0,
+            ry0,
+            rx1,
+            ry1,
+            ca,
+            cb,
+            ra,
+            rb,
+        }
+    }
+}
+
+/// The gate, a view of the label plane once the labels are spent: per cell of the
+/// window (`pw` per row), nonzero when the cell is the winner's or touches one of its
+/// cells (over the region's cells only). Boundaries count only at gated pixels.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Gate<'a> {
+    cells: &'a [u8],
+    pw: usize,
+    win: Window,
+}
+
+impl Gate<'_> {
+    /// True when pixel `(x, y)` (frame coordinates, inside the region) is gated.
+    #[inline(always)]
+    pub fn contains(&self, x: usize, y: usize) -> bool {
+        self.cells[(y - self.win.y0) / BLOCK * self.pw + (x - self.win.x0) / BLOCK] != 0
+    }
+
+    /// Cells `ca..cb` of cell row `cy`.
+    #[inline(always)]
+    pub fn cells(&self, cy: usize, ca: usize, cb: usize) -> &[u8] {
+        &self.cells[cy * self.pw + ca..cy * self.pw + cb]
+    }
+}
+
+/// Builds the gate of the winner `root` over the region into `labels` (the label
+/// plane, `pw × ph` cells; it becomes the gate), with `row_dilated` (the step-code
+/// plane, free after labelling: the winner dilated along rows) and `winner_row` (one
+/// cell row of the winner, padded by a cell on each side). Labels `1..next` are in use.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn build_gate<'a>(
+    labels: &'a mut [u8],
+    row_dilated: &mut [u8],
+    winner_row: &mut [bool],
+    comps: &mut EdgeComponents,
+    root: u8,
+    next: usize,
+    region: &Region,
+    win: Window,
+    (pw, ph): (usize, usize),
+) -> Gate<'a> {
+    // Every label to its root first (at most 250 finds), so the gate is
+    // comparisons only: the winner's cells dilated by one cell, along rows into
+    // `row_dilated`, then down columns into `labels` (which becomes the gate).
+    comps.flatten(1..next, |l| l as u8);
+    comps.set_parent(0, 0);
+    let parent = comps.parents();
+    let Region { ca, cb, ra, rb, .. } = *region;
+    let (cwa, cwb) = (ca.saturating_sub(1), (cb + 1).min(pw));
+    // The winner's cells of one cell row, padded by a cell on each side:
+    // `winner[cx + 1]` is cell cx.
+    let winner = &mut winner_row[..pw + 2];
+    winner.fill(false);
+    for cy in ra.saturating_sub(1)..(rb + 1).min(ph) {
+        let cells = &labels[cy * pw + cwa..cy * pw + cwb];
+        for (w, &l) in winner[cwa + 1..cwb + 1].iter_mut().zip(cells) {
+            *w = parent[usize::from(l)] == root;
+        }
+        // Along the row: out[cx] = w[cx − 1] | w[cx] | w[cx + 1].
+        let out = &mut row_dilated[cy * pw + ca..cy * pw + cb];
+        let (left, mid, right) = (&winner[ca..cb], &winner[ca + 1..], &winner[ca + 2..]);
+        for (((o, &l), &m), &r) in out.iter_mut().zip(left).zip(mid).zip(right) {
+            *o = u8::from(l | m | r);
+        }
+    }
+    for cy in ra..rb {
+        let row = |gy: usize| &row_dilated[gy * pw + ca..gy * pw + cb];
+        let up = row(cy.saturating_sub(1));
+        let down = row((cy + 1).min(ph - 1));
+        for (((g, &u), &m), &d) in labels[cy * pw + ca..cy * pw + cb]
+            .iter_mut()
+            .zip(up)
+            .zip(row(cy))
+            .zip(down)
+        {
+            *g = u | m | d;
+        }
+    }
+    Gate {
+        cells: labels,
+        pw,
+        win,
+    }
+}
+
+/// Saturated pixels of the gated cells of the region, per column and row.
+pub(super) struct SaturationCounts<'a> {
+    /// Saturated pixels per column of the region (`col_sat[i]`: column `rx0 + i`).
+    pub col_sat: &'a [u16],
+    /// Saturated pixels per row of the region.
+    pub row_sat: &'a [u16],
+    /// Saturated pixels in all.
+    pub sat_px: u32,
+    /// Pixels within the near-saturation band below the top DN, not saturated.
+    pub near_px: u32,
+}
+
+/// Counts saturated pixels (and pixels at `near_sat` DN or above) over the gated
+/// cells of the region, into `col_sat` and `row_sat` (region-sized slices).
+pub(super) fn count_saturation<'a>(
+    frame: &Frame<'_>,
+    gate: &Gate<'_>,
+    region: &Region,
+    near_sat: u16,
+    col_sat: &'a mut [u16],
+    row_sat: &'a mut [u16],
+) -> SaturationCounts<'a> {
+    let max_dn = frame.max_dn();
+    let win = gate.win;
+    let Region {
+        rx0,
+        ry0,
+        rx1,
+        ry1,
+        ca,
+        cb,
+        ..
+    } = *region;
+    // Saturation counts, over the gated cells.
+    let (mut sat_px, mut near_px) = (0u32, 0u32);
+    col_sat.fill(0);
+    row_sat.fill(0);
+    // Runs of gated cells of a cell row as pixel ranges relative to rx0 (set for
+    // each cell row): the counts touch gated pixels only, a slice per run.
+    let mut runs = [(0u16, 0u16); PLANE_WIDTH / 2 + 1];
+    let (mut n_runs, mut runs_row) = (0, usize::MAX);
+    for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
+        let Some(row) = frame.row(y) else { continue };
+        let row = &row[rx0..rx1];
+        // Most rows of a radiometry frame hold no pixel near saturation (a max is
+        // cheaper than the counts).
+        if row.iter().fold(0, |m, &v| m.max(v)) < near_sat {
+            continue;
+        }
+        let cy = (y - win.y0) / BLOCK;
+        if cy != runs_row {
+            runs_row = cy;
+            n_runs = 0;
+            let cells = gate.cells(cy, ca, cb);
+            let mut open = None;
+            for (i, &g) in cells.iter().chain(&[0]).enumerate() {
+                match (open, g != 0) {
+                    (None, true) => open = Some(i),
+                    (Some(start), false) => {
+                        let px = |c: usize| (c * BLOCK).min(row.len()) as u16;
+                        if let Some(r) = runs.get_mut(n_runs) {
+                            *r = (px(start), px(i));
+                            n_runs += 1;
+                        }
+                        open = None;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        // (v ≥ max_dn is v saturated; near_sat ≤ max_dn: no clamp needed.)
+        let (mut sat_row, mut near) = (0u16, 0u16);
+        for &(a, b) in &runs[..n_runs] {
+            let (a, b) = (usize::from(a), usize::from(b));
+            for (&v, cs) in row[a..b].iter().zip(&mut col_sat[a..b]) {
+                let sat = u16::from(v >= max_dn);
+                *cs += sat;
+                sat_row += sat;
+                near += u16::from(v >= near_sat) & (1 - sat);
+            }
+        }
+        let (sat_row, near) = (u32::from(sat_row), u32::from(near));
+        *rs = sat_row as u16;
+        sat_px += sat_row;
+        near_px += near;
+    }
+    SaturationCounts {
+        col_sat,
+        row_sat,
+        sat_px,
+        near_px,
+    }
+}
+
+/// The box of the outermost boundaries in the region (the saturated pixels' box,
+/// joined with boundaries of unsaturated faces beyond it, for a `saturated` target)
+/// and the boundary pixels found. `tau`: the boundary threshold, DN.
+pub(super) fn outline(
+    frame: &Frame<'_>,
+    gate: &Gate<'_>,
+    region: &Region,
+    noise: Noise,
+    tau: u16,
+    saturated: bool,
+    sat_counts: &SaturationCounts<'_>,
+) -> (Option<Roi>, u32) {
+    let max_dn = frame.max_dn();
+    let fw = frame.width();
+    let clean = noise.clean;
+    let Region {
+        rx0, ry0, rx1, ry1, ..
+    } = *region;
+    let (tau, keep_saturated) = if saturated {
+        (tau.saturating_mul(SATURATED_TAU_FACTOR), false)
+    } else {
+        (tau, true)
+    };
+    let gated = |x: usize, y: usize| gate.contains(x, y);
+    let clamp = |v: u16| v.min(max_dn);
+    let rows = |y: usize| frame.row(y).map(|r| &r[..fw]);
+    // A boundary at pixel x of row y from a horizontal step: `Some(b)` (a boundary
+    // before column b) when |v(x+1) − v(x−1)| ≥ τ, no neighbouring step along the
+    // row is larger, and the pixels are gated (and unsaturated, unless kept).
+    // In clean deep space a faint face (a few hundred DN, below τ) still shows as a
+    // solid patch above 0 DN, where the clipped noise is a sparse sprinkle: a step
+    // from 0 DN counts when the pixel beyond it and its four neighbours are above 0.
+    let solid = |x: usize, y: usize| {
+        let at = |x: usize, y: usize| rows(y).and_then(|r| r.get(x)).is_some_and(|&v| v > 0);
+        x > 0 && y > 0 && at(x, y) && at(x - 1, y) && at(x + 1, y) && at(x, y - 1) && at(x, y + 1)
+    };
+    let faint = |a: u16, b: u16, beyond: Option<(usize, usize)>| {
+        clean && a.min(b) == 0 && a.max(b) > 0 && beyond.is_some_and(|(x, y)| solid(x, y))
+    };
+    let h_boundary = |row: &[u16], x: usize, y: usize| -> Option<usize> {
+        if x == 0 || x + 1 >= fw {
+            return None;
+        }
+        let (l, v, r) = (clamp(row[x - 1]), clamp(row[x]), clamp(row[x + 1]));
+        let step = l.abs_diff(r);
+        let beyond = if l == 0 {
+            Some((x + 1, y))
+        } else {
+            Some((x - 1, y))
+        };
+        if (step < tau && !faint(l, r, beyond))
+            || !(keep_saturated || l.max(r) < max_dn)
+            || !gated(x, y)
+        {
+            return None;
+        }
+        let before = x.checked_sub(2).map_or(0, |i| clamp(row[i]).abs_diff(v));
+        let after = row.get(x + 2).map_or(0, |&w| clamp(w).abs_diff(v));
+        (step >= before && step >= after).then_some(if v.abs_diff(l) >= v.abs_diff(r) {
+            x
+        } else {
+            x + 1
+        })
+    };
+    // The same down a column: a boundary before row b.
+    let v_boundary = |x: usize, y: usize| -> Option<usize> {
+        let (Some(a), Some(v), Some(d)) = (y.checked_sub(1).and_then(rows), rows(y), rows(y + 1))
+        else {
+            return None;
+        };
+        let (u, v, d) = (clamp(a[x]), clamp(v[x]), clamp(d[x]));
+        let step = u.abs_diff(d);
+        let beyond = if u == 0 {
+            Some((x, y + 1))
+        } else {
+            Some((x, y - 1))
+        };
+        if (step < tau && !faint(u, d, beyond))
+            || !(keep_saturated || u.max(d) < max_dn)
+            || !gated(x, y)
+        {
+            return None;
+        }
+        let before = y
+            .checked_sub(2)
+            .and_then(rows)
+            .map_or(0, |r| clamp(r[x]).abs_diff(v));
+        let after = rows(y + 2).map_or(0, |r| clamp(r[x]).abs_diff(v));
+        (step >= before && step >= after).then_some(if v.abs_diff(u) >= v.abs_diff(d) {
+            y
+        } else {
+            y + 1
+        })
+    };
+    // Outside in: the box needs only the outermost boundaries, so each row is
+    // scanned from the left until its first boundary (or until it cannot beat the
+    // leftmost one so far) and from the right alike; rows are scanned from the top
+    // until one holds a boundary from a vertical step, and from the bottom alike.
+    // A saturated target's box comes from its saturated pixels; boundaries of cold
+    // faces matter only beyond it.
+    let sat = if saturated {
+        saturated_box(sat_counts.col_sat, rx0, sat_counts.row_sat, ry0)
+    } else {
+        None
+    };
+    let (lim_x0, lim_y0, lim_x1, lim_y1) = sat.map_or((rx1, ry1, rx0, ry0), |s| {
+        (
+            usize::from(s.x0),
+            usize::from(s.y0),
+            usize::from(s.x1),
+            usize::from(s.y1),
+        )
+    });
+    let mut found = Boundaries::NONE;
+    // The cheap test of a pixel pair (clamped) before the boundary tests: a step of
+    // τ, or (clean deep space) 0 DN beside a pixel above it.
+    let candidate =
+        |l: u16, r: u16| l.abs_diff(r) >= tau || (clean && l.min(r) == 0 && l.max(r) > 0);
+    // One row per cell band first (cheap bounds for the rest), then every row.
+    let sparse = (ry0 + BLOCK / 2..ry1).step_by(BLOCK);
+    for y in sparse.chain(ry0..ry1) {
+        let Some(row) = rows(y) else { continue };
+        // Pixels x of [xa, xb) with both neighbours in the frame, first to last (or
+        // last to first): the first boundary found.
+        let scan = |xa: usize, xb: usize, backwards: bool| {
+            let (xa, xb) = (xa.max(1), xb.min(fw - 1));
+            let triples = row.get(xa.wrapping_sub(1)..xb + 1).filter(|_| xa < xb)?;
+            let mut hits = (xa..xb)
+                .zip(triples.windows(3))
+                .filter(|(_, t)| candidate(clamp(t[0]), clamp(t[2])));
+            if backwards {
+                hits.rev().find_map(|(x, _)| h_boundary(row, x, y))
+            } else {
+                hits.find_map(|(x, _)| h_boundary(row, x, y))
+            }
+        };
+        let left_end = lim_x0.min(rx1).min(found.bx.0.saturating_add(1));
+        if let Some(b) = scan(rx0, left_end, false) {
+            found.add_x(b, y);
+        }
+        let right_start = rx0.max(lim_x1).max(found.bx.1.saturating_sub(1));
+        if let Some(b) = scan(right_start, rx1, true) {
+            found.add_x(b, y);
+        }
+    }
+    let vertical = |y: usize, found: &mut Boundaries| {
+        let (Some(a), Some(d)) = (y.checked_sub(1).and_then(rows), rows(y + 1)) else {
+            return false;
+        };
+        // Most rows hold no candidate: one pass that vectorises says so.
+        let (a, d) = (&a[rx0..rx1], &d[rx0..rx1]);
+        let largest = a
+            .iter()
+            .zip(d)
+            .fold(0, |m, (&u, &w)| m.max(clamp(u).abs_diff(clamp(w))));
+        if largest < tau && !(clean && a.iter().zip(d).any(|(&u, &w)| (u == 0) != (w == 0))) {
+            return false;
+        }
+        let mut hit = false;
+        for (x, (&u, &w)) in (rx0..rx1).zip(a.iter().zip(d)) {
+            if !candidate(clamp(u), clamp(w)) {
+                continue;
+            }
+            if let Some(b) = v_boundary(x, y) {
+                found.add_y(x, b);
+                hit = true;
+            }
+        }
+        hit
+    };
+    for y in ry0..ry1.min(lim_y0) {
+        if vertical(y, &mut found) {
+            break;
+        }
+    }
+    for y in (ry0.max(lim_y1)..ry1).rev() {
+        if y < found.by.1 || vertical(y, &mut found) {
+            break;
+        }
+    }
+    let edge_px = found.count;
+    let roi = match sat {
+        Some(s) => Some(found.roi().map_or(s, |u| s.hull(&u))),
+        None if saturated => None,
+        None => found.roi(),
+    };
+    (roi, edge_px)
+}
+
+/// The outermost boundaries seen by the refinement, and the hull of their pixels.
+#[derive(Debug, Clone, Copy)]
+struct Boundaries {
+    /// Boundaries between columns (from horizontal steps): smallest and largest.
+    bx: (usize, usize),
+    /// Boundaries between rows (from vertical steps): smallest and largest.
+    by: (usize, usize),
+    /// Hull of the step pixels: x range, y range (exclusive ends).
+    hx: (usize, usize),
+    hy: (usize, usize),
+    count: u32,
+}
+
+impl Boundaries {
+    const NONE: Boundaries = Boundaries {
+        bx: (usize::MAX, 0),
+        by: (usize::MAX, 0),
+        hx: (usize::MAX, 0),
+        hy: (usize::MAX, 0),
+        count: 0,
+    };
+
+    fn pixel(&mut self, x: usize, y: usize) {
+        self.hx = (self.hx.0.min(x), self.hx.1.max(x + 1));
+        self.hy = (self.hy.0.min(y), self.hy.1.max(y + 1));
+        self.count += 1;
+    }
+
+    /// A boundary before column `b`, seen on row `y`.
+    fn add_x(&mut self, b: usize, y: usize) {
+        self.bx = (self.bx.0.min(b), self.bx.1.max(b));
+        self.pixel(b.saturating_sub(1), y);
+    }
+
+    /// A boundary before row `b`, seen in column `x`.
+    fn add_y(&mut self, x: usize, b: usize) {
+        self.by = (self.by.0.min(b), self.by.1.max(b));
+        self.pixel(x, b.saturating_sub(1));
+    }
+
+    /// The box between the outermost boundaries (the step pixels' hull along an axis
+    /// without two boundaries).
+    fn roi(&self) -> Option<Roi> {
+        if self.count == 0 {
+            return None;
+        }
+        let (x0, x1) = if self.bx.0 < self.bx.1 {
+            self.bx
+        } else {
+            self.hx
+        };
+        let (y0, y1) = if self.by.0 < self.by.1 {
+            self.by
+        } else {
+            self.hy
+        };
+        Some(Roi::new(x0 as u16, y0 as u16, x1 as u16, y1 as u16))
+    }
+}
+
+/// The box of the saturated pixels from their column and row counts (`col_sat[i]` is
+/// column `x0 + i`), with outermost lines of at most [`TRIM_LINE_PX`] pixels trimmed
+/// ([`TRIM_PASSES`] times per side at most): pixels less than half covered by a saturating target saturate
+/// too, and stick out of the truth box one at a time.
+pub(super) fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usize) -> Option<Roi> {
+    let span = |counts: &[u16]| {
+        let first = counts.iter().position(|&c| c > 0)?;
+        let last = counts.iter().rposition(|&c| c > 0)?;
+        let (mut a, mut b) = (first, last + 1);
+        let line = usize::from(TRIM_LINE_PX);
+        for _ in 0..TRIM_PASSES {
+            if b - a > line && counts[a] <= TRIM_LINE_PX {
+                a += 1;
+            }
+            if b - a > line && counts[b - 1] <= TRIM_LINE_PX {
+                b -= 1;
+            }
+        }
+        Some((a, b))
+    };
+    let (xa, xb) = span(col_sat)?;
+    let (ya, yb) = span(row_sat)?;
+    Some(Roi::new(
+        (x0 + xa) as u16,
+        (y0 + ya) as u16,
+        (x0 + xb) as u16,
+        (y0 + yb) as u16,
+    ))
+}

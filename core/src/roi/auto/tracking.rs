@@ -1,0 +1,66 @@
+//! Tracking: with a prior box, the pipeline runs first on a window around it (the
+//! prior grown by `margin_px + max(width, height) / margin_divisor`); if nothing is
+//! found there, or the box found misses the prior or reaches the window's border, on
+//! the full frame.
+
+use super::super::Detection;
+use super::super::plane::Window;
+use super::{Auto, AutoWork, Found};
+use crate::frame::Frame;
+
+impl Auto {
+    /// The detection (box, coarse threshold, edge pixels), tracking window first.
+    pub(super) fn run(&self, frame: &Frame<'_>, work: &mut AutoWork) -> Detection {
+        let full = Window::full(frame);
+        if let Some(p) = self.prior {
+            let p = p.clip(frame.width() as u16, frame.height() as u16);
+            if !p.is_empty() {
+                let m = usize::from(self.margin_px)
+                    + usize::from(p.width().max(p.height())) / usize::from(self.margin_divisor);
+                let win = Window::clipped(
+                    frame,
+                    usize::from(p.x0).saturating_sub(m),
+                    usize::from(p.y0).saturating_sub(m),
+                    usize::from(p.x1) + m,
+                    usize::from(p.y1) + m,
+                );
+                if let Some(win) = win.filter(|w| !w.is_full(frame)) {
+                    if let Some(f) = self.locate(frame, work, win) {
+                        // Still the tracked target: the box overlaps the prior and is
+                        // not cut by the window (a side on the window's border is one
+                        // the frame's border, or the target left the window).
+                        let (fw, fh) = (frame.width(), frame.height());
+                        let kept = f.roi.is_some_and(|r| {
+                            let (x0, y0) = (usize::from(r.x0), usize::from(r.y0));
+                            let (x1, y1) = (usize::from(r.x1), usize::from(r.y1));
+                            !r.intersection(&p).is_empty()
+                                && (x0 > win.x0 || win.x0 == 0)
+                                && (y0 > win.y0 || win.y0 == 0)
+                                && (x1 < win.x0 + win.w || x1 == fw)
+                                && (y1 < win.y0 + win.h || y1 == fh)
+                        });
+                        if kept {
+                            return detection(f);
+                        }
+                    }
+                }
+            }
+        }
+        match self.locate(frame, work, full) {
+            Some(f) => detection(f),
+            None => Detection {
+                roi: None,
+                threshold: 0,
+                foreground_px: 0,
+            },
+        }
+    }
+}
+
+fn detection(f: Found) -> Detection {
+    Detection {
+        roi: f.roi,
+        threshold: f.threshold,
+        foreground_px: f.edge_px,
+    }
+}
