@@ -8,12 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use serde_json::Value;
-use tirroi::core::roi::adaptive::Adaptive;
-use tirroi::core::roi::auto::{Auto, AutoScratch};
-use tirroi::core::roi::dog::{Dog, DogScratch};
-use tirroi::core::roi::otsu::Otsu;
-use tirroi::core::roi::wge::Wge;
-use tirroi::core::{Detection, Detector, Method, Roi};
+use tirroi::core::roi::Detectors;
+use tirroi::core::{Detection, Method, Roi};
 use tirroi::host::imaging::fixture;
 use tirroi::host::imaging::image_io::read_frame;
 
@@ -42,14 +38,9 @@ fn fixtures() -> tempfile::TempDir {
 fn library_detection(method: Method, path: &Path) -> Detection {
     let buf = read_frame(path, None).expect("readable frame");
     let frame = buf.view().expect("valid frame");
-    match method {
-        Method::Otsu => Otsu::default().detect(&frame, &mut Default::default()),
-        Method::Adaptive => Adaptive::default().detect(&frame, &mut Default::default()),
-        Method::Wge => Wge::default().detect(&frame, &mut Default::default()),
-        Method::Dog => Dog::default().detect(&frame, &mut Box::<DogScratch>::default()),
-        Method::Auto => Auto::default().detect(&frame, &mut Box::<AutoScratch>::default()),
-    }
-    .expect("default parameters are valid")
+    let mut bank = Box::new(Detectors::new());
+    bank.detect(&method.default_params(), &frame)
+        .expect("default parameters are valid")
 }
 
 /// Parses one `detect --json` line and checks its shape; returns (file, method, bbox).

@@ -7,10 +7,11 @@ mod cli_common;
 use std::path::Path;
 
 use cli_common::run;
+use tirroi_core::roi::Params;
 use tirroi_core::{BoxRule, Method, Roi};
 use tirroi_host::eval::scoring::{TruthRow, read_truth};
 use tirroi_host::eval::split::{self, Split};
-use tirroi_host::eval::tune::{self, Params, SearchOptions};
+use tirroi_host::eval::tune::{self, SearchOptions, defaults};
 use tirroi_host::imaging::image_io::{FrameBuf, write_png16};
 
 fn row(file: &str) -> TruthRow {
@@ -163,9 +164,9 @@ fn search_scores_the_whole_grid_and_beats_or_matches_the_defaults() {
     for method in [Method::Adaptive, Method::Wge] {
         let grid = tune::grid(method);
         let defaults: Vec<String> = [BoxRule::LargestComponent, BoxRule::AllForeground]
-            .map(|r| Params::defaults(method, r).describe())
+            .map(|r| defaults(method, r).to_string())
             .to_vec();
-        let described: Vec<String> = grid.iter().map(Params::describe).collect();
+        let described: Vec<String> = grid.iter().map(Params::to_string).collect();
         for d in &defaults {
             assert!(
                 described.contains(d),
@@ -191,7 +192,7 @@ fn search_scores_the_whole_grid_and_beats_or_matches_the_defaults() {
         );
         // The best is the best trial, and at least as good as the defaults.
         assert_eq!(best.params.method(), method);
-        assert_eq!(best.trial.params, best.params.describe());
+        assert_eq!(best.trial.params, best.params.to_string());
         assert!(trials.contains(&best.trial));
         let top = trials.iter().map(|t| t.mean_iou).fold(0.0, f64::max);
         assert!((best.trial.mean_iou - top).abs() < 1e-9, "{method}");

@@ -80,6 +80,12 @@ macro_rules! detector_registry {
             pub const ALL: [$Method; [$(stringify!($Variant)),+].len()] =
                 [$($Method::$Variant),+];
 
+            /// Position in [`Self::ALL`] (registry order).
+            #[inline]
+            pub const fn index(self) -> usize {
+                self as usize
+            }
+
             /// The lower-case name used on the command line (`Detector::NAME`).
             pub const fn name(self) -> &'static str {
                 match self {

@@ -35,7 +35,7 @@ pub fn run(repeat: usize, figures: Option<&Path>) -> ExitCode {
             return ExitCode::from(EXIT_BAD_INPUT);
         };
         let mut drawn = vec![(fx.truth, overlay::TRUTH_COLOUR)];
-        for (method, colour) in Method::ALL.into_iter().zip(overlay::METHOD_COLOURS) {
+        for (method, colour) in Method::ALL.map(|m| (m, overlay::method_colour(m))) {
             let mut cells = Vec::new();
             let mut time_us = 0.0;
             for rule in [BoxRule::AllForeground, BoxRule::LargestComponent] {

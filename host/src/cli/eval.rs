@@ -42,13 +42,9 @@ pub struct EvalArgs {
 }
 
 fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
-    match s {
-        "largest-component" => Ok(BoxRule::LargestComponent),
-        "all-foreground" => Ok(BoxRule::AllForeground),
-        _ => Err(format!(
-            "unknown box rule `{s}`; expected largest-component or all-foreground"
-        )),
-    }
+    BoxRule::from_name(s).ok_or_else(|| {
+        format!("unknown box rule `{s}`; expected largest-component or all-foreground")
+    })
 }
 
 fn parse_track(s: &str) -> Result<scoring::Track, String> {

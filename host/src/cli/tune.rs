@@ -8,7 +8,7 @@ use tirroi_core::BoxRule;
 use super::methods::{MethodChoice, parse_methods};
 use crate::eval::scoring;
 use crate::eval::split::{Split, TUNE_PERCENT, Where, filter, parse_where, split};
-use crate::eval::tune::{Params, SearchOptions, evaluate, grid, search, trials_csv};
+use crate::eval::tune::{SearchOptions, defaults, evaluate, grid, search, trials_csv};
 use crate::progress;
 
 /// The options of `tirroi tune`.
@@ -104,18 +104,18 @@ pub fn run(args: &TuneArgs) -> Result<(), String> {
         let m = best.params.method();
         let test = evaluate(&args.images, &test_rows, &best.params, args.bits)
             .map_err(|e| e.to_string())?;
-        let defaults = Params::defaults(m, BoxRule::LargestComponent);
+        let default_set = defaults(m, BoxRule::LargestComponent);
         let default_tune = result
             .trials
             .iter()
-            .find(|t| t.method == m.name() && t.params == defaults.describe())
+            .find(|t| t.method == m.name() && t.params == default_set.to_string())
             .map(|t| t.mean_iou)
             .unwrap_or(f64::NAN);
-        let default_test =
-            evaluate(&args.images, &test_rows, &defaults, args.bits).map_err(|e| e.to_string())?;
+        let default_test = evaluate(&args.images, &test_rows, &default_set, args.bits)
+            .map_err(|e| e.to_string())?;
         table.push_str(&format!(
             "| {m} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {default_tune:.3} | {:.3} |\n",
-            best.params.describe(),
+            best.params,
             best.moves,
             best.trial.mean_iou,
             best.trial.median_iou,

@@ -2,41 +2,52 @@
 
 use std::time::Instant;
 
-use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
-use tirroi_core::roi::auto::{Auto, AutoScratch};
-use tirroi_core::roi::dog::{Dog, DogScratch};
-use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
-use tirroi_core::roi::wge::{Wge, WgeScratch};
-use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Method};
+use tirroi_core::roi::{Detectors, Params};
+use tirroi_core::{BoxRule, DetectError, Detection, Frame, Method, Roi};
 
-/// The five detectors with their parameters and their scratch memory (boxed: DoG's
-/// is 70 KiB), ready to run frame after frame.
-#[derive(Default)]
+/// Every registered detector (the core's registry, [`Method::ALL`]) with its
+/// parameters and its scratch memory (boxed: about 141 KB), ready to run frame after
+/// frame.
 pub struct DetectorBank {
-    /// Otsu parameters.
-    pub otsu: Otsu,
-    /// Adaptive-threshold parameters.
-    pub adaptive: Adaptive,
-    /// WGE parameters.
-    pub wge: Wge,
-    /// DoG parameters.
-    pub dog: Dog,
-    /// `auto` parameters (its `prior` is used as given: set it for tracking).
-    pub auto: Auto,
-    otsu_scratch: Box<OtsuScratch>,
-    adaptive_scratch: Box<AdaptiveScratch>,
-    wge_scratch: Box<WgeScratch>,
-    dog_scratch: Box<DogScratch>,
-    auto_scratch: Box<AutoScratch>,
+    /// The parameters of each method, at [`Method::index`].
+    params: [Params; Method::ALL.len()],
+    scratch: Box<Detectors>,
+}
+
+impl Default for DetectorBank {
+    /// Every detector with its default parameters.
+    fn default() -> Self {
+        DetectorBank {
+            params: Method::ALL.map(Method::default_params),
+            scratch: Box::new(Detectors::new()),
+        }
+    }
 }
 
 impl DetectorBank {
+    /// The parameters `method` runs with.
+    pub fn params(&self, method: Method) -> Params {
+        self.params[method.index()]
+    }
+
+    /// Sets the parameters of their method (the other methods keep theirs).
+    pub fn set_params(&mut self, params: Params) {
+        self.params[params.method().index()] = params;
+    }
+
+    /// Sets `auto`'s tracking prior (the last frame's box; `None`: search the whole
+    /// frame).
+    pub fn set_prior(&mut self, prior: Option<Roi>) {
+        if let Params::Auto(auto) = &mut self.params[Method::Auto.index()] {
+            auto.prior = prior;
+        }
+    }
+
     /// Sets the mask-to-box rule of every detector (`auto` has none).
     pub fn set_box_rule(&mut self, rule: BoxRule) {
-        self.otsu.box_rule = rule;
-        self.adaptive.box_rule = rule;
-        self.wge.box_rule = rule;
-        self.dog.box_rule = rule;
+        for p in &mut self.params {
+            p.set_box_rule(rule);
+        }
     }
 
     /// Runs `method` on `frame`.
@@ -44,13 +55,7 @@ impl DetectorBank {
     /// # Errors
     /// The core's [`DetectError`] for parameters out of bounds.
     pub fn detect(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        match method {
-            Method::Otsu => self.otsu.detect(frame, &mut self.otsu_scratch),
-            Method::Adaptive => self.adaptive.detect(frame, &mut self.adaptive_scratch),
-            Method::Wge => self.wge.detect(frame, &mut self.wge_scratch),
-            Method::Dog => self.dog.detect(frame, &mut self.dog_scratch),
-            Method::Auto => self.auto.detect(frame, &mut self.auto_scratch),
-        }
+        self.scratch.detect(&self.params[method.index()], frame)
     }
 
     /// Runs `method` `repeat` times (at least once) and returns the detection with the

@@ -244,7 +244,7 @@ pub fn score(
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
                 let mut out = Vec::with_capacity(options.methods.len());
                 if options.track == Track::Jitter {
-                    bank.auto.prior = Some(jittered_prior(row.roi, &row.file));
+                    bank.set_prior(Some(jittered_prior(row.roi, &row.file)));
                 }
                 for &m in &options.methods {
                     out.push(score_one(bank, m, &view, row, &path, options.repeat)?.0);
@@ -310,7 +310,7 @@ fn score_sequence(
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
-        bank.auto.prior = previous;
+        bank.set_prior(previous);
         for &m in &options.methods {
             let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
             if m == Method::Auto {

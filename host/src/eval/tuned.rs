@@ -45,6 +45,7 @@
 //! (no gradient floor) finds nothing at far range.
 
 use tirroi_core::BoxRule;
+use tirroi_core::roi::Params;
 use tirroi_core::roi::adaptive::Adaptive;
 use tirroi_core::roi::dog::Dog;
 use tirroi_core::roi::otsu::Otsu;
@@ -211,26 +212,25 @@ pub fn tuned_bank(kind: TunedFor) -> DetectorBank {
         TunedFor::Tango => (TANGO_OTSU, TANGO_ADAPTIVE, TANGO_WGE, TANGO_DOG),
     };
     let mut bank = DetectorBank::default();
-    bank.otsu = otsu;
-    bank.adaptive = adaptive;
-    bank.wge = wge;
-    bank.dog = dog;
+    bank.set_params(Params::Otsu(otsu));
+    bank.set_params(Params::Adaptive(adaptive));
+    bank.set_params(Params::Wge(wge));
+    bank.set_params(Params::Dog(dog));
     bank
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tirroi_core::{Detector, Method};
+    use tirroi_core::Method;
 
     #[test]
     fn every_tuned_set_is_valid() {
         for kind in TunedFor::ALL {
             let bank = tuned_bank(kind);
-            assert!(bank.otsu.validate().is_ok(), "{}", kind.name());
-            assert!(bank.adaptive.validate().is_ok(), "{}", kind.name());
-            assert!(bank.wge.validate().is_ok(), "{}", kind.name());
-            assert!(bank.dog.validate().is_ok(), "{}", kind.name());
+            for m in Method::ALL {
+                assert!(bank.params(m).validate().is_ok(), "{} {m}", kind.name());
+            }
         }
     }
 

@@ -3,13 +3,15 @@
 use std::path::Path;
 
 use image::{Rgb, RgbImage};
-use tirroi_core::Roi;
+use tirroi_core::{Method, Roi};
 
 use crate::imaging::image_io::{FrameBuf, FrameFileError};
 
-/// Box colours: truth, then one per detector in `Method::ALL` order.
+/// Colour of the truth box.
 pub const TRUTH_COLOUR: [u8; 3] = [0, 220, 0];
-/// Colours of Otsu, adaptive, WGE and DoG boxes.
+/// Colours of the detectors' boxes, in registry order (`Method::ALL`: otsu, adaptive,
+/// WGE, DoG, auto); a detector beyond them takes them again from the start
+/// ([`method_colour`]).
 pub const METHOD_COLOURS: [[u8; 3]; 5] = [
     [255, 60, 60],
     [60, 140, 255],
@@ -17,6 +19,11 @@ pub const METHOD_COLOURS: [[u8; 3]; 5] = [
     [220, 0, 220],
     [0, 230, 230],
 ];
+
+/// The box colour of `method` ([`METHOD_COLOURS`] at its registry position).
+pub fn method_colour(method: Method) -> [u8; 3] {
+    METHOD_COLOURS[method.index() % METHOD_COLOURS.len()]
+}
 
 /// The frame as an RGB image, DN stretched linearly from the frame's minimum (black)
 /// to its maximum (white), magnified `scale` times, with each box's outline drawn

@@ -32,16 +32,16 @@
 //! rather than once per set. Measured (release, 2 cores shared with other work): four
 //! methods on 88 tune frames in 16–21 s, on 367–373 tune frames in 32–90 s.
 
-mod params;
 mod search;
+mod space;
 #[cfg(test)]
 mod tests;
 
-pub use params::{
-    AUTO_SIGMA_LADDER, BLOCK_LADDER, DROP_LADDER, GRADIENT_LADDER, OFFSET_LADDER, Params,
-    RATIO_LADDER, RESPONSE_LADDER, SIGMA0_LADDER, box_rule_name, grid,
-};
 pub use search::{
     MethodBest, SearchOptions, Trial, TuneResult, evaluate, evaluate_together, search,
     search_method, trials_csv,
+};
+pub use space::{
+    AUTO_SIGMA_LADDER, BLOCK_LADDER, DROP_LADDER, GRADIENT_LADDER, OFFSET_LADDER, RATIO_LADDER,
+    RESPONSE_LADDER, SIGMA0_LADDER, defaults, grid, is_valid, neighbours,
 };

@@ -6,7 +6,9 @@ use std::path::Path;
 
 use tirroi_core::{BoxRule, Method};
 
-use super::params::{Params, grid};
+use tirroi_core::roi::Params;
+
+use super::space::{grid, neighbours};
 use crate::eval::bank::DetectorBank;
 use crate::eval::scoring::{self, EvalError, EvalOptions, FrameScore, TruthRow};
 
@@ -15,7 +17,7 @@ use crate::eval::scoring::{self, EvalError, EvalOptions, FrameScore, TruthRow};
 pub struct Trial {
     /// Method name.
     pub method: &'static str,
-    /// The parameters, as [`Params::describe`].
+    /// The parameters, as `Params`' `Display` (`name=value` pairs).
     pub params: String,
     /// Mean IoU over the frames.
     pub mean_iou: f64,
@@ -119,13 +121,13 @@ pub fn evaluate_together(
             return Err(EvalError(format!(
                 "parameter sets scored together need distinct methods: {}",
                 sets.iter()
-                    .map(|p| format!("{} {}", p.method(), p.describe()))
+                    .map(|p| format!("{} {}", p.method(), p))
                     .collect::<Vec<_>>()
                     .join("; ")
             )));
         }
     }
-    // Each set brings its own box rule (`Params::apply`).
+    // Each set brings its own box rule (`DetectorBank::set_params`).
     let options = EvalOptions {
         methods,
         repeat: 1,
@@ -136,7 +138,7 @@ pub fn evaluate_together(
     let make_bank = || {
         let mut bank = DetectorBank::default();
         for p in sets {
-            p.apply(&mut bank);
+            bank.set_params(*p);
         }
         bank
     };
@@ -149,7 +151,7 @@ pub fn evaluate_together(
             let s = scoring::stats(name, "all", "all", &mine);
             Trial {
                 method: name,
-                params: p.describe(),
+                params: p.to_string(),
                 mean_iou: s.mean_iou,
                 median_iou: s.median_iou,
                 mean_time_ms: s.mean_time_ms,
@@ -171,7 +173,7 @@ impl MethodSearch {
         on_trial(&t);
         self.trials.push(t);
         let i = self.trials.len() - 1;
-        self.seen.insert(p.describe(), i);
+        self.seen.insert(p.to_string(), i);
         i
     }
 
@@ -184,7 +186,7 @@ impl MethodSearch {
         options: &SearchOptions,
         on_trial: &dyn Fn(&Trial),
     ) -> Result<usize, EvalError> {
-        if let Some(&i) = self.seen.get(&p.describe()) {
+        if let Some(&i) = self.seen.get(&p.to_string()) {
             return Ok(i);
         }
         let t = evaluate(images, rows, p, options.bits)?;
@@ -211,7 +213,7 @@ impl MethodSearch {
             let (mut here, mut at, mut moves) = (start, start_at, 0);
             while moves < options.refine_steps {
                 let mut next: Option<(Params, usize)> = None;
-                for p in here.neighbours() {
+                for p in neighbours(&here) {
                     let i = self.score(&p, images, rows, options, on_trial)?;
                     let incumbent = next.map_or(at, |(_, n)| n);
                     if self.trials[i].beats(&self.trials[incumbent]) {
@@ -308,7 +310,7 @@ pub fn search(
             let mut owners = Vec::new();
             for (k, list) in lists.iter().enumerate() {
                 if let Some(p) = list.get(pass) {
-                    if !searches[k].seen.contains_key(&p.describe()) {
+                    if !searches[k].seen.contains_key(&p.to_string()) {
                         sets.push(*p);
                         owners.push(k);
                     }
@@ -328,7 +330,7 @@ pub fn search(
     };
     for mut s in searches {
         let best = s.refine(images, rows, options, on_trial)?;
-        best.params.apply(&mut result.bank);
+        result.bank.set_params(best.params);
         result.trials.append(&mut s.trials);
         result.best.push(best);
     }

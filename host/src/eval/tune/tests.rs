@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use tirroi_core::roi::Params;
 use tirroi_core::roi::dog::Dog;
 use tirroi_core::{BoxRule, Method};
 
@@ -14,10 +15,10 @@ fn grids_hold_the_defaults_and_are_valid() {
     for m in Method::ALL {
         let g = grid(m);
         for rule in [BoxRule::AllForeground, BoxRule::LargestComponent] {
-            assert!(g.contains(&Params::defaults(m, rule)), "{m} {rule:?}");
+            assert!(g.contains(&defaults(m, rule)), "{m} {rule:?}");
         }
-        assert!(g.iter().all(|p| p.is_valid() && p.method() == m));
-        let mut names: Vec<String> = g.iter().map(Params::describe).collect();
+        assert!(g.iter().all(|p| is_valid(p) && p.method() == m));
+        let mut names: Vec<String> = g.iter().map(Params::to_string).collect();
         names.sort();
         names.dedup();
         assert_eq!(names.len(), g.len(), "{m}: a set twice");
@@ -31,7 +32,7 @@ fn grids_hold_the_defaults_and_are_valid() {
 fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
     let lc = BoxRule::LargestComponent;
     let af = BoxRule::AllForeground;
-    let a = Params::defaults(Method::Adaptive, lc);
+    let a = defaults(Method::Adaptive, lc);
     let none = Path::new("/nonexistent");
     assert!(evaluate_together(none, &[], &[a, a], None).is_err());
     assert_eq!(evaluate_together(none, &[], &[], None), Ok(Vec::new()));
@@ -52,22 +53,22 @@ fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
         });
     }
     // Sets of different rules scored together score as each alone.
-    let sets = [a, Params::defaults(Method::Wge, af)];
+    let sets = [a, defaults(Method::Wge, af)];
     let together = evaluate_together(&dir, &rows, &sets, None).unwrap();
     for (p, t) in sets.iter().zip(&together) {
         let alone = evaluate(&dir, &rows, p, None).unwrap();
         assert_eq!((&t.params, t.mean_iou), (&alone.params, alone.mean_iou));
     }
     // And the rule matters on these frames, so the check above has teeth.
-    let wge_lc = evaluate(&dir, &rows, &Params::defaults(Method::Wge, lc), None).unwrap();
+    let wge_lc = evaluate(&dir, &rows, &defaults(Method::Wge, lc), None).unwrap();
     assert!((wge_lc.mean_iou - together[1].mean_iou).abs() > 0.05);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn neighbours_step_one_rung() {
-    let p = Params::defaults(Method::Adaptive, BoxRule::LargestComponent);
-    let n: Vec<String> = p.neighbours().iter().map(Params::describe).collect();
+    let p = defaults(Method::Adaptive, BoxRule::LargestComponent);
+    let n: Vec<String> = neighbours(&p).iter().map(Params::to_string).collect();
     assert_eq!(
         n,
         [
@@ -82,7 +83,7 @@ fn neighbours_step_one_rung() {
         levels: 8,
         ..Dog::default()
     });
-    assert!(top.neighbours().iter().all(Params::is_valid));
+    assert!(neighbours(&top).iter().all(is_valid));
 }
 
 #[test]

@@ -188,7 +188,7 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
             &dirs.paper,
             &scores.detection,
             &picks,
-            &["otsu", "adaptive", "wge", "dog"],
+            &Method::PAPER.map(Method::name),
             &p,
         )?;
         written.push(p);
@@ -213,7 +213,7 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
         &dirs.paper,
         &scores.radiometry,
         &picks,
-        &["otsu", "adaptive", "wge", "dog"],
+        &Method::PAPER.map(Method::name),
         &p,
     )?;
     written.push(p);

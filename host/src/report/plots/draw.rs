@@ -12,6 +12,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::register_font;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use tirroi_core::Method;
 
 use super::{EXTRA_METHOD_COLOURS, FONT_BYTES, FONT_FAMILY, PlotError};
 use crate::imaging::overlay;
@@ -279,11 +280,9 @@ pub(super) struct Palette {
     pub(super) colours: Vec<RGBColor>,
 }
 
-const KNOWN_METHODS: [&str; 4] = ["otsu", "adaptive", "wge", "dog"];
-
 impl Palette {
     pub(super) fn new<'a>(names: impl Iterator<Item = &'a str>) -> Palette {
-        let mut known = [false; 4];
+        let mut known = [false; Method::ALL.len()];
         let mut extra: Vec<String> = Vec::new();
         for n in names {
             match known_index(n) {
@@ -299,10 +298,10 @@ impl Palette {
             names: Vec::new(),
             colours: Vec::new(),
         };
-        for (k, name) in KNOWN_METHODS.iter().enumerate() {
+        for (k, method) in Method::ALL.into_iter().enumerate() {
             if known[k] {
-                p.names.push((*name).to_string());
-                p.colours.push(rgb(overlay::METHOD_COLOURS[k]));
+                p.names.push(method.name().to_string());
+                p.colours.push(rgb(overlay::method_colour(method)));
             }
         }
         for (i, name) in extra.into_iter().enumerate() {
@@ -320,7 +319,7 @@ impl Palette {
     /// Index of a method name (known names matched without case).
     pub(super) fn index(&self, name: &str) -> usize {
         let key = match known_index(name) {
-            Some(k) => KNOWN_METHODS[k],
+            Some(k) => Method::ALL[k].name(),
             None => name,
         };
         self.names.iter().position(|n| n == key).unwrap_or(0)
@@ -336,10 +335,11 @@ impl Palette {
     }
 }
 
+/// Registry position of a method name (compared without case).
 fn known_index(name: &str) -> Option<usize> {
-    KNOWN_METHODS
+    Method::ALL
         .iter()
-        .position(|k| k.eq_ignore_ascii_case(name.trim()))
+        .position(|m| m.name().eq_ignore_ascii_case(name.trim()))
 }
 
 /// Smallest step of the form {1, 2, 5}·10^k that is at least `raw`.

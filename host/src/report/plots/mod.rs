@@ -13,11 +13,12 @@
 //! panel per group or frame are [`panel_figure_size`]; the example grid's size follows
 //! its frames (see [`example_grid`]).
 //!
-//! Colours: truth [`TRUTH_COLOUR`](crate::imaging::overlay::TRUTH_COLOUR); the methods `otsu`, `adaptive`, `wge`, `dog`
-//! (names compared without case) take [`METHOD_COLOURS`](crate::imaging::overlay::METHOD_COLOURS) in that order, and any
-//! other method name takes the next of [`EXTRA_METHOD_COLOURS`] in order of first
-//! appearance in the input. Legends list the four known methods first, in that order,
-//! then the others by first appearance.
+//! Colours: truth [`TRUTH_COLOUR`](crate::imaging::overlay::TRUTH_COLOUR); the registry's
+//! methods (`tirroi_core::Method::ALL`, names compared without case) take
+//! [`method_colour`](crate::imaging::overlay::method_colour), the same as in the box
+//! pictures, and any other method name takes the next of [`EXTRA_METHOD_COLOURS`] in
+//! order of first appearance in the input. Legends list the registry's methods first,
+//! in registry order, then the others by first appearance.
 //!
 //! Empty input (no point, no frame, or only non-finite values) is an error
 //! ([`PlotError`] saying "no data") and no file is written: a figure without data is
