@@ -13,7 +13,8 @@ pub const FRAME_WIDTH: usize = 328;
 pub const FRAME_HEIGHT: usize = 248;
 /// Pixels in a full reference frame (328 × 248 = 81 344).
 pub const FRAME_PIXELS: usize = FRAME_WIDTH * FRAME_HEIGHT;
-/// Default bit depth of a DN: 14 bits, DN 0..=16383 (DESIGN.md).
+/// Default bit depth of a DN: 14 bits, DN 0..=16383 (the project's convention; the
+/// host reads a 16-bit PNG whose values fit as 14-bit DN).
 pub const DEFAULT_BIT_DEPTH: u8 = 14;
 /// Largest supported bit depth: a DN is a `u16`.
 pub const MAX_BIT_DEPTH: u8 = 16;

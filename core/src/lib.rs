@@ -16,6 +16,36 @@
 //!   rows read through an embedded-hal 1.0 `SpiDevice` by `link::FrameReader`, and a
 //!   `link::SimulatedCamera` serving a stored frame.
 //!
+//! ## Example: find the target in one frame
+//!
+//! A 328×248 frame of 14-bit DN: deep space at 200 DN, a warm target at 9 000 DN
+//! filling columns 100..180 and rows 60..140. `auto` needs no tuning; its scratch
+//! (about 25 KB) is boxed here, a `static` on flight hardware.
+//!
+//! ```
+//! use tirroi_core::roi::auto::{Auto, AutoScratch};
+//! use tirroi_core::{Detector, Frame, Roi};
+//!
+//! const W: usize = 328;
+//! const H: usize = 248;
+//! let mut pixels = vec![200u16; W * H];
+//! for y in 60..140 {
+//!     pixels[y * W + 100..y * W + 180].fill(9_000);
+//! }
+//! let frame = Frame::new(&pixels, W, H, 14).unwrap();
+//!
+//! let mut scratch: Box<AutoScratch> = Box::new(AutoScratch::new());
+//! let found = Auto::default().detect(&frame, &mut scratch).unwrap();
+//!
+//! // Boxes are [x0, y0, x1, y1]: x right, y down, (x0, y0) inclusive, (x1, y1) exclusive.
+//! assert_eq!(found.roi, Some(Roi::new(100, 60, 180, 140)));
+//!
+//! // Tracking: the next frame, with this box as the prior, searches a window around it.
+//! let tracker = Auto::default().with_prior(found.roi);
+//! let next = tracker.detect(&frame, &mut scratch).unwrap();
+//! assert_eq!(next.roi, found.roi);
+//! ```
+//!
 //! ## Memory per detector
 //!
 //! Each detector works in a [`roi::Scratch`] whose size is fixed at compile time; the
@@ -31,7 +61,7 @@
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 296 | 96 KiB |
 //! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 456 | 32 KiB |
 //!
-//! The exact figures are printed by `tirroi memory` and listed in the README.
+//! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
 //!
 //! ## Memory of the camera model
 //!

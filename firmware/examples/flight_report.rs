@@ -13,7 +13,7 @@
 //! Fails (exit 1) when a firmware run failed, a box or foreground count differs from
 //! the host's, an on-board sensor frame differs from the host's, or the firmware does
 //! not fit the flash and RAM of `memory.x`. Writes `DIR/report.md` with the tables the
-//! README's flight section shows, and prints it.
+//! flight page (`docs/flight.md`) shows, and prints it.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

@@ -1,4 +1,6 @@
-//! Axis-aligned boxes on the pixel grid, with the DESIGN.md convention.
+//! Axis-aligned boxes on the pixel grid, with the project's convention (also the
+//! labels' and the CLI's, see `docs/architecture.md`): x right, y down, 0-based,
+//! `[x0, y0, x1, y1]` with (x0, y0) inclusive and (x1, y1) exclusive.
 
 /// An axis-aligned box `[x0, y0, x1, y1]` in pixels: x right, y down, 0-based,
 /// (x0, y0) inclusive and (x1, y1) exclusive.

@@ -17,7 +17,7 @@
 //! [`super::Params`] and [`super::Detectors`]; the host CLI, evaluation, tuning,
 //! plots, the firmware and the tests all dispatch through them. Adding a detector is
 //! its module (parameters implementing [`Detector`], `Default`, `Copy`, `Display`) plus
-//! one line in that registry; the test `tests/registry.rs` of the core declares a
+//! one line in that registry; the test `core/tests/registry.rs` declares a
 //! registry with a toy detector to show it.
 //!
 //! [`Detector`]: super::Detector

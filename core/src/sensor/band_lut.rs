@@ -4,10 +4,10 @@
 //! §3). f32 only, no `log` call (the node index comes from the float's exponent bits),
 //! one `expf` per call.
 //!
-//! Error: ≤ 1e-5 relative (asserted in tests/sensor_radiance.rs; measured figures in
-//! the README) wherever L is a normal f32 (13 K and up); 0 below 2.5 K, where
-//! L < 1.4e-173 is far below the f32 range anyway. Above 5120 K (to
-//! the model's limit of 10 000 K) ln L is extrapolated linearly along the last slope:
+//! Error: ≤ 1e-5 relative (asserted in core/tests/sensor_radiance.rs; measured
+//! figures in docs/camera-model.md) wherever L is a normal f32 (13 K and up); 0 below
+//! 2.5 K, where L < 1.4e-173 is far below the f32 range anyway. Above 5120 K (to the
+//! model's limit of 10 000 K) ln L is extrapolated linearly along the last slope:
 //! finite and monotone, not accuracy-checked.
 
 use super::SensorError;

@@ -16,7 +16,7 @@ use crate::frame::MAX_BIT_DEPTH;
 ///
 /// Under the reading of [`crate::sensor::flux`] (ΔA_c = the whole sensor area, Earth at
 /// 10 871 km, band radiance of the TIR model) the warmest Earth cell (OLR 330 W m⁻²,
-/// 276.2 K) gives 2.07·10⁻¹⁷ W m⁻²: the same order (tests/sensor_scales.rs).
+/// 276.2 K) gives 2.07·10⁻¹⁷ W m⁻²: the same order (core/tests/sensor_scales.rs).
 pub const EARTH_MAX_FLUX_TABLE5_W_M2: f64 = 3e-17;
 
 /// The fixed radiance scales of detection mode (paper Table 5): q_min = 0 and q_max a

@@ -18,7 +18,7 @@
 //! 10 871 km gives q_fc = 2.07·10⁻¹⁷ W m⁻² with the TIR band model (2.38·10⁻¹⁷ for a box
 //! 8–12 µm band), the order of Table 5's 3·10⁻¹⁷. A pixel's area would give 10⁻²², an
 //! aperture 10⁻¹⁶ (`shared/reference/REFERENCE.md` §4; asserted in
-//! tests/sensor_scales.rs).
+//! core/tests/sensor_scales.rs).
 
 use super::{SensorError, check_positive, check_range};
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH};

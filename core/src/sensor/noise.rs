@@ -13,7 +13,7 @@
 //!
 //! [`RmsReading`] selects the set: `Table2` (the default) uses the published values, as
 //! the paper's noise maps did; `AsPrinted` and `Physical` compute them. The searches
-//! behind the table are in `shared/reference/REFERENCE.md` §1; tests/sensor_noise.rs
+//! behind the table are in `shared/reference/REFERENCE.md` §1; core/tests/sensor_noise.rs
 //! asserts every number above to four significant digits.
 //!
 //! # Noise levels, and why `netd` is the default

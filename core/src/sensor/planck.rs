@@ -11,7 +11,7 @@
 //! wavelength cut. Each node stores c₂/λ and the weight w·R(λ)·c₁/λ⁵, so one radiance
 //! costs one `expm1` per node and no cancellation: B = c₁λ⁻⁵/expm1(c₂/λT).
 //!
-//! # Accuracy (tests/sensor_radiance.rs against the 30-digit table)
+//! # Accuracy (core/tests/sensor_radiance.rs against the 30-digit table)
 //!
 //! | path | domain | worst relative error |
 //! |---|---|---|

@@ -6,7 +6,8 @@
 //! least-squares fit to the measured TIR curve: a logistic rise (the lens and filter
 //! cut-on), a logistic fall (the filter cut-off), and an exponential tilt for the
 //! plateau that falls towards long wavelengths. Its 30-digit band integrals are in
-//! `tests/data/band_radiance_reference.csv`, made by `scripts/reference/band_radiance.py`.
+//! `core/tests/data/band_radiance_reference.csv`, made by
+//! `scripts/reference/band_radiance.py`.
 
 use super::{SensorError, check_positive, check_range};
 

@@ -32,7 +32,9 @@ pub struct DetectArgs {
     pub files: Vec<PathBuf>,
 }
 
-/// The JSON line of `tirroi detect --json` (DESIGN.md).
+/// The JSON line of `tirroi detect --json`: `{"file","method","bbox":[x0,y0,x1,y1] or
+/// null,"time_us"}`, `time_us` the median over `--repeat` runs of the core call alone
+/// (the conventions in `docs/architecture.md`).
 #[derive(Debug, Serialize)]
 struct DetectLine<'a> {
     file: &'a str,

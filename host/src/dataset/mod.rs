@@ -3,8 +3,9 @@
 //! computed once, and the images render in parallel into a directory:
 //!
 //! - `NNNNNN.png`: 16-bit grayscale DN (the core's sensor model);
-//! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (DESIGN convention; the box is
-//!   the tight box of the pixels whose target coverage is ≥ 0.5);
+//! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (the box: (x0, y0)
+//!   inclusive, (x1, y1) exclusive, the tight box of the pixels whose target coverage
+//!   is ≥ 0.5);
 //! - `coco.json`: COCO detection labels (one category, `spacecraft`);
 //! - `metadata.jsonl`: one JSON object per image (pose, mode, scale, material,
 //!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures);

@@ -2,10 +2,11 @@
 //! IoU against the truth box and the core's run time, per method and per group
 //! (material case, scale, illumination, range band, target), as the paper's Tables 6–8.
 //!
-//! `truth.csv` needs the columns `file,x0,y0,x1,y1` first (DESIGN convention: x0, y0
-//! inclusive, x1, y1 exclusive); extra columns become group labels when they are one of
-//! `mode`, `scale`, `target`, `material`, `illumination`, and `range_m` gives the range
-//! band (close ≤ 50 m, far ≥ 300 m, else mid). Timing is the core call alone on one
+//! `truth.csv` needs the columns `file,x0,y0,x1,y1` first (the project's box
+//! convention, `docs/architecture.md`: x0, y0 inclusive, x1, y1 exclusive); extra
+//! columns become group labels when they are one of `mode`, `scale`, `target`,
+//! `material`, `illumination`, and `range_m` gives the range band (close ≤ 50 m, far
+//! ≥ 300 m, else mid). Timing is the core call alone on one
 //! thread, the median of `repeat` runs; images are scored in parallel.
 
 use std::collections::BTreeMap;
