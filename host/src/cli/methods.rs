@@ -17,6 +17,7 @@ pub fn parse_methods(s: &str) -> Result<MethodChoice, String> {
     Method::from_name(s)
         .map(|m| MethodChoice(vec![m]))
         .ok_or_else(|| {
-            format!("unknown method `{s}`; expected otsu, adaptive, wge, dog, auto or all")
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown method `{s}`; expected {} or all", names.join(", "))
         })
 }

@@ -20,7 +20,7 @@ pub struct TuneArgs {
     /// Labels (default: IMAGES/truth.csv), header `file,x0,y0,x1,y1[,extra...]`.
     #[arg(long)]
     pub truth: Option<PathBuf>,
-    /// Detector to tune: otsu, adaptive, wge, dog, or all.
+    /// Detector to tune: otsu, adaptive, wge, dog, auto, or all (the five).
     #[arg(long, default_value = "all", value_parser = parse_methods)]
     pub method: MethodChoice,
     /// Keep only frames with this group label, `key=value`; key: mode, scale, target,
