@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use serde_json::Value;
+use tirroi::core::roi::Scratch;
 use tirroi::core::roi::adaptive::Adaptive;
 use tirroi::core::roi::auto::{Auto, AutoScratch};
 use tirroi::core::roi::dog::{Dog, DogScratch};
@@ -43,9 +44,9 @@ fn library_detection(method: Method, path: &Path) -> Detection {
     let buf = read_frame(path, None).expect("readable frame");
     let frame = buf.view().expect("valid frame");
     match method {
-        Method::Otsu => Otsu::default().detect(&frame, &mut Default::default()),
-        Method::Adaptive => Adaptive::default().detect(&frame, &mut Default::default()),
-        Method::Wge => Wge::default().detect(&frame, &mut Default::default()),
+        Method::Otsu => Otsu::default().detect(&frame, &mut Scratch::new()),
+        Method::Adaptive => Adaptive::default().detect(&frame, &mut Scratch::new()),
+        Method::Wge => Wge::default().detect(&frame, &mut Scratch::new()),
         Method::Dog => Dog::default().detect(&frame, &mut Box::<DogScratch>::default()),
         Method::Auto => Auto::default().detect(&frame, &mut Box::<AutoScratch>::default()),
     }
