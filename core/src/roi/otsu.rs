@@ -77,6 +77,11 @@ pub const SCRATCH_BYTES: usize = core::mem::size_of::<OtsuScratch>();
 
 /// An exact value of the between-class variance, up to the common factor 1/N⁴:
 /// `d² / den` with `d = M·n₀ − N·m₀` and `den = n₀·(N − n₀)`.
+///
+/// Bounds, for frames up to the largest capacity (N ≤ 1024·768 < 2^20, DN < 2^16):
+/// `|d| = n₀·n₁·|μ₁ − μ₀| ≤ (N²/4)·2^16 < 2^54`, so `d² < 2^108`; `den ≤ N²/4 < 2^38`,
+/// so the cross-multiplied remainders stay below 2^76; the branch-and-bound's
+/// `|d_a| + k·S` (`S ≤ N·2^16`) stays below 2^57. All far inside `u128`/`i128`.
 #[derive(Debug, Clone, Copy)]
 struct Score {
     d2: u128,

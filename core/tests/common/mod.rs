@@ -522,9 +522,17 @@ pub fn otsu_exhaustive(pixels: &[u16], bits: u8) -> Option<u32> {
         let den = u128::from(n0) * u128::from(n - n0);
         let better = match best {
             None => true,
-            Some((_, bd2, bden)) => {
-                d2.checked_mul(bden).expect("bound") > bd2.checked_mul(den).expect("bound")
-            }
+            Some((_, bd2, bden)) => match (d2.checked_mul(bden), bd2.checked_mul(den)) {
+                (Some(a), Some(b)) => a > b,
+                // Frames above the reference size: quotients, then remainders
+                // cross-multiplied (each below its denominator ≤ N²/4 < 2^38 for
+                // N ≤ 1024·768, so products < 2^76).
+                _ => {
+                    let (q1, r1) = (d2 / den, d2 % den);
+                    let (q2, r2) = (bd2 / bden, bd2 % bden);
+                    q1 > q2 || (q1 == q2 && r1 * bden > r2 * den)
+                }
+            },
         };
         if better {
             best = Some((t as u32, d2, den));
