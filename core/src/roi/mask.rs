@@ -273,24 +273,18 @@ impl<C: FrameCapacity> RoiBuilder<C> {
     fn link_runs(&mut self, y: usize) {
         let mut j0 = 0;
         let c = self.cur_side;
-        let [runs0, runs1] = &mut self.runs;
-        let (cur, prev) = if c == 0 {
-            (runs0, runs1)
-        } else {
-            (runs1, runs0)
-        };
-        let (cur, prev) = (cur.as_mut(), prev.as_ref());
+        let p = 1 - c;
         for i in 0..self.cur_len {
-            let run = cur[i];
+            let run = self.runs[c].as_ref()[i];
             // Runs above that end left of this run's left neighbour can no longer touch
             // this or any later run.
-            while j0 < self.prev_len && prev[j0].x1 < run.x0 {
+            while j0 < self.prev_len && self.runs[p].as_ref()[j0].x1 < run.x0 {
                 j0 += 1;
             }
             let mut label = FREE;
             let mut j = j0;
-            while j < self.prev_len && prev[j].x0 <= run.x1 {
-                let root = self.table.find(prev[j].label);
+            while j < self.prev_len && self.runs[p].as_ref()[j].x0 <= run.x1 {
+                let root = self.table.find(self.runs[p].as_ref()[j].label);
                 label = if label == FREE {
                     root
                 } else {
@@ -314,7 +308,7 @@ impl<C: FrameCapacity> RoiBuilder<C> {
                 comp.area += u32::from(run.x1 - run.x0);
                 comp.first = comp.first.min(y as u32 * width + u32::from(run.x0));
             }
-            cur[i].label = label;
+            self.runs[c].as_mut()[i].label = label;
         }
     }
 

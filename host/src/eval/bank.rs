@@ -2,12 +2,14 @@
 
 use std::time::Instant;
 
+use tirroi_core::capacity::{Cap640x512, Cap1024x768};
 use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
 use tirroi_core::roi::auto::{Auto, AutoScratch};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
-use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Method};
+use tirroi_core::roi::{Detectors, Params};
+use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, FrameCapacity, Method};
 
 /// The five detectors with their parameters and their scratch memory (boxed: DoG's
 /// is 70 KiB), ready to run frame after frame.
@@ -28,6 +30,21 @@ pub struct DetectorBank {
     wge_scratch: Box<WgeScratch>,
     dog_scratch: Box<DogScratch>,
     auto_scratch: Box<AutoScratch>,
+    /// Scratch of the larger capacities, made on the first frame that needs them.
+    larger: LargerBanks,
+}
+
+/// The core's registry banks of the capacities above the reference 328×248: the
+/// smallest that holds a frame runs it.
+#[derive(Default)]
+struct LargerBanks {
+    c640x512: Option<Box<Detectors<Cap640x512>>>,
+    c1024x768: Option<Box<Detectors<Cap1024x768>>>,
+}
+
+/// True when `frame` fits capacity `C`.
+fn fits<C: FrameCapacity>(frame: &Frame<'_>) -> bool {
+    frame.width() <= C::WIDTH && frame.height() <= C::HEIGHT
 }
 
 impl DetectorBank {
@@ -42,8 +59,30 @@ impl DetectorBank {
     /// Runs `method` on `frame`.
     ///
     /// # Errors
-    /// The core's [`DetectError`] for parameters out of bounds.
+    /// The core's [`DetectError`] for parameters out of bounds or a frame above the
+    /// largest capacity (1024×768).
     pub fn detect(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
+        if !fits::<tirroi_core::Reference>(frame) {
+            let params = match method {
+                Method::Otsu => Params::Otsu(self.otsu),
+                Method::Adaptive => Params::Adaptive(self.adaptive),
+                Method::Wge => Params::Wge(self.wge),
+                Method::Dog => Params::Dog(self.dog),
+                Method::Auto => Params::Auto(self.auto),
+            };
+            let larger = &mut self.larger;
+            return if fits::<Cap640x512>(frame) {
+                larger
+                    .c640x512
+                    .get_or_insert_with(Box::default)
+                    .detect(&params, frame)
+            } else {
+                larger
+                    .c1024x768
+                    .get_or_insert_with(Box::default)
+                    .detect(&params, frame)
+            };
+        }
         match method {
             Method::Otsu => self.otsu.detect(frame, &mut self.otsu_scratch),
             Method::Adaptive => self.adaptive.detect(frame, &mut self.adaptive_scratch),
