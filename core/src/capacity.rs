@@ -201,10 +201,12 @@ const fn check_bounds(w: usize, h: usize, count_bytes: usize) {
     assert!(w >= 1 && h >= 1);
     // `auto`: inclusive cell coordinates in `u8`.
     assert!(cells(w) <= 256 && cells(h) <= 256);
+    // (u64: `usize` is 32 bits on the flight targets.)
+    let px = w as u64 * h as u64;
     // `otsu`: packed sums of `v − bin start` (< 2^9) over the frame in 32 bits.
-    assert!(511 * w * h < 1 << 32);
+    assert!(511 * px < 1 << 32);
     // `otsu`: refinement counters hold half the frame.
-    assert!((w * h).div_ceil(2) < 1 << (8 * count_bytes));
+    assert!(px.div_ceil(2) < 1u64 << (8 * count_bytes));
     // The mask-to-box labelling: `u16` run ends, labels and row stamps.
     assert!(w < u16::MAX as usize && h < u16::MAX as usize);
 }
