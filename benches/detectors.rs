@@ -24,7 +24,7 @@ fn frames() -> Vec<(&'static str, Fixture)> {
 fn bench_detector<D: Detector>(
     c: &mut Criterion,
     detector: D,
-    scratch: &mut tirroi::core::roi::Scratch<D::Work>,
+    scratch: &mut tirroi::core::roi::Scratch<D::Work<tirroi::core::Reference>>,
 ) {
     let mut group = c.benchmark_group(D::NAME);
     for (name, fx) in frames() {

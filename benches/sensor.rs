@@ -76,7 +76,15 @@ fn frame_pass(c: &mut Criterion) {
     let mut g = c.benchmark_group("frame_pass");
     g.throughput(Throughput::Elements((W * H) as u64));
     g.bench_function("dn_only", |b| {
-        b.iter(|| expose_frame(black_box(&signal), W, &mapping, None, &mut out))
+        b.iter(|| {
+            expose_frame(
+                black_box(&signal),
+                W,
+                &mapping,
+                None::<&mut NoiseField>,
+                &mut out,
+            )
+        })
     });
     g.bench_function("dn_plus_noise", |b| {
         b.iter(|| {

@@ -174,6 +174,42 @@ fn detect_small_8_bit_png_with_known_box() {
     assert_eq!(bbox, Some(Roi::new(5, 3, 9, 7).to_array()));
 }
 
+#[test]
+fn detect_a_640x512_png_with_every_method() {
+    // Larger than the reference 328×248: the bank runs it at the 640×512 capacity.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.png");
+    let mut img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(640, 512, |x, y| {
+        image::Luma([100 + ((x * 7 + y * 13) % 7) as u16])
+    });
+    for y in 300..420 {
+        for x in 400..520 {
+            img.put_pixel(x, y, image::Luma([5000 + ((x * 7 + y * 13) % 7) as u16]));
+        }
+    }
+    img.save(&path).unwrap();
+    let out = run(&[
+        "detect",
+        "--method",
+        "all",
+        "--json",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), Method::ALL.len());
+    for line in &lines {
+        let (_, method, bbox) = parse_line(line);
+        if method == "otsu" || method == "auto" {
+            assert_eq!(
+                bbox,
+                Some(Roi::new(400, 300, 520, 420).to_array()),
+                "{line}"
+            );
+        }
+    }
+}
+
 /// Asserts a failed run: exit code 2, exactly one stderr line naming `file`, no panic.
 #[track_caller]
 fn assert_one_clean_error(out: &Output, file: &Path) {
@@ -204,11 +240,11 @@ fn bad_files_give_one_error_line_and_exit_code_2() {
         .save(&rgb)
         .unwrap();
     let large = dir.path().join("large.png");
-    image::GrayImage::from_pixel(400, 300, image::Luma([7]))
+    image::GrayImage::from_pixel(1025, 300, image::Luma([7]))
         .save(&large)
         .unwrap();
     let large16 = dir.path().join("large16.png");
-    image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(329, 10, image::Luma([7]))
+    image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(10, 769, image::Luma([7]))
         .save(&large16)
         .unwrap();
     for file in [

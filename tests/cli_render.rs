@@ -198,6 +198,32 @@ fn a_stopped_run_resumes_to_the_same_bytes() {
 }
 
 #[test]
+fn renders_a_640x512_camera() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = tmp.path().join("big.toml");
+    fs::write(
+        &config,
+        "[dataset]\nname = \"big\"\nseed = 5\n[camera]\nwidth = 640\nheight = 512\n\
+         [[scene]]\nname = \"rad\"\ncount = 1\nmode = \"radiometry\"\nrange_m = 20.0\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let report = render_into(&config, &out, "1", &[]);
+    assert!(report.contains("1 images rendered"), "{report}");
+    let png = fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|e| e == "png"))
+        .expect("a PNG");
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (640, 512));
+    // And the detectors take it.
+    let o = run(&["detect", "--method", "all", "--json", png.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
 fn bad_scene_files_name_the_file_line_and_field() {
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");

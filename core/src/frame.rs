@@ -16,6 +16,10 @@ pub const FRAME_PIXELS: usize = FRAME_WIDTH * FRAME_HEIGHT;
 /// Default bit depth of a DN: 14 bits, DN 0..=16383 (the project's convention; the
 /// host reads a 16-bit PNG whose values fit as 14-bit DN).
 pub const DEFAULT_BIT_DEPTH: u8 = 14;
+/// Largest frame side a [`Frame`] accepts, pixels (box coordinates are `u16`). The
+/// detectors hold less: each refuses a frame above its scratch's capacity
+/// ([`crate::roi::DetectError::FrameTooLarge`], [`crate::capacity`]).
+pub const MAX_FRAME_SIDE: usize = u16::MAX as usize - 1;
 /// Largest supported bit depth: a DN is a `u16`.
 pub const MAX_BIT_DEPTH: u8 = 16;
 
@@ -24,8 +28,8 @@ pub const MAX_BIT_DEPTH: u8 = 16;
 pub enum FrameError {
     /// Width or height is zero.
     ZeroSize,
-    /// Width or height exceeds the detectors' capacity of
-    /// [`FRAME_WIDTH`] × [`FRAME_HEIGHT`].
+    /// Width or height exceeds [`MAX_FRAME_SIDE`] (a detector's own capacity is
+    /// checked when it runs: [`crate::roi::DetectError::FrameTooLarge`]).
     TooLarge {
         /// Requested width in pixels.
         width: usize,
@@ -49,7 +53,7 @@ impl fmt::Display for FrameError {
             FrameError::ZeroSize => write!(f, "frame width and height must be at least 1 pixel"),
             FrameError::TooLarge { width, height } => write!(
                 f,
-                "frame is {width}x{height} px, larger than the {FRAME_WIDTH}x{FRAME_HEIGHT} px the detectors hold"
+                "frame is {width}x{height} px, a side above {MAX_FRAME_SIDE} px"
             ),
             FrameError::WrongLength { expected, actual } => write!(
                 f,
@@ -62,8 +66,8 @@ impl fmt::Display for FrameError {
     }
 }
 
-/// A row-major frame of DN borrowed from the caller, at most
-/// [`FRAME_WIDTH`] × [`FRAME_HEIGHT`] pixels.
+/// A row-major frame of DN borrowed from the caller, at most [`MAX_FRAME_SIDE`] pixels
+/// a side (the detectors check their own capacity, 328×248 by default).
 ///
 /// Pixel (x, y) is `pixels()[y * width + x]`, x right and y down. DN above
 /// [`Frame::max_dn`] are not rejected (that would cost a pass over the frame); every
@@ -91,7 +95,7 @@ impl<'a> Frame<'a> {
         if width == 0 || height == 0 {
             return Err(FrameError::ZeroSize);
         }
-        if width > FRAME_WIDTH || height > FRAME_HEIGHT {
+        if width > MAX_FRAME_SIDE || height > MAX_FRAME_SIDE {
             return Err(FrameError::TooLarge { width, height });
         }
         if bits == 0 || bits > MAX_BIT_DEPTH {
@@ -120,12 +124,12 @@ impl<'a> Frame<'a> {
         Self::new(pixels, FRAME_WIDTH, FRAME_HEIGHT, DEFAULT_BIT_DEPTH)
     }
 
-    /// Width in pixels (1..=328).
+    /// Width in pixels (1..=[`MAX_FRAME_SIDE`]).
     pub const fn width(&self) -> usize {
         self.width
     }
 
-    /// Height in pixels (1..=248).
+    /// Height in pixels (1..=[`MAX_FRAME_SIDE`]).
     pub const fn height(&self) -> usize {
         self.height
     }

@@ -76,11 +76,13 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod capacity;
 pub mod frame;
 #[cfg(feature = "spi")]
 pub mod link;
 pub mod roi;
 pub mod sensor;
 
+pub use capacity::{Capacity, FrameCapacity, Reference};
 pub use frame::{Frame, FrameError};
 pub use roi::{BoxRule, DetectError, Detection, Detector, Method, Roi};

@@ -8,8 +8,9 @@
 
 use core::fmt;
 
+use tirroi_core::capacity::{Cap640x512, ConstInit};
 use tirroi_core::roi::{self, BoxRule, DetectError, Detector, Scratch};
-use tirroi_core::{Frame, Roi};
+use tirroi_core::{Frame, FrameCapacity, Reference, Roi};
 
 /// The toy: foreground = DN ≥ (brightest DN − `band_dn`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,16 +36,21 @@ impl fmt::Display for Peak {
     }
 }
 
-/// The toy's buffers: one mask row.
+/// The toy's buffers at capacity `C`: one mask row (`C::Row<bool>`, `[bool; W]`).
 #[derive(Debug, Clone)]
-pub struct PeakWork {
-    mask: [bool; 328],
+pub struct PeakWork<C: FrameCapacity> {
+    mask: C::Row<bool>,
+}
+
+impl<C: FrameCapacity> ConstInit for PeakWork<C> {
+    const INIT: Self = PeakWork {
+        mask: ConstInit::INIT,
+    };
 }
 
 impl Detector for Peak {
-    type Work = PeakWork;
+    type Work<C: FrameCapacity> = PeakWork<C>;
     const NAME: &'static str = "peak";
-    const WORK: PeakWork = PeakWork { mask: [false; 328] };
 
     fn validate(&self) -> Result<(), DetectError> {
         if self.band_dn > 1000 {
@@ -64,16 +70,16 @@ impl Detector for Peak {
         self.box_rule = rule;
     }
 
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut PeakWork,
+        work: &mut PeakWork<C>,
         mut sink: F,
     ) -> u32 {
         let peak = frame.pixels().iter().copied().max().unwrap_or(0);
         let threshold = peak.saturating_sub(self.band_dn);
         for (y, row) in frame.rows().enumerate() {
-            let mask = &mut work.mask[..row.len()];
+            let mask = &mut work.mask.as_mut()[..row.len()];
             for (m, &v) in mask.iter_mut().zip(row) {
                 *m = v >= threshold;
             }
@@ -185,7 +191,7 @@ fn one_entry_gives_names_parsing_defaults_and_scratch_bytes() {
     }
     assert_eq!(
         Method::Peak.scratch_bytes(),
-        core::mem::size_of::<Scratch<PeakWork>>()
+        core::mem::size_of::<Scratch<PeakWork<Reference>>>()
     );
     assert_eq!(
         Method::Peak.default_params().to_string(),
@@ -240,4 +246,15 @@ fn the_bank_runs_the_toy_like_a_brute_force_reference() {
         let b = core_bank.detect(&core.default_params(), &frame).unwrap();
         assert_eq!(a, b, "{core}");
     }
+    // A bank of a larger capacity: the same boxes; the toy's row grows with it.
+    let mut big = Box::new(Detectors::<Cap640x512>::for_capacity());
+    for m in Method::ALL {
+        let a = bank.detect(&m.default_params(), &frame).unwrap();
+        assert_eq!(big.detect(&m.default_params(), &frame).unwrap(), a, "{m}");
+    }
+    assert_eq!(
+        Method::Peak.scratch_bytes_for::<Cap640x512>() - Method::Peak.scratch_bytes(),
+        core::mem::size_of::<Scratch<PeakWork<Cap640x512>, Cap640x512>>()
+            - core::mem::size_of::<Scratch<PeakWork<Reference>>>()
+    );
 }

@@ -284,9 +284,18 @@ fn literal_noise_vanishes_in_quantisation_and_frames_saturate() {
 
     // Sizes are checked.
     let mut short = vec![0u16; 10];
-    assert!(expose_frame(&signal, W, &m, None, &mut short).is_err());
-    assert!(expose_frame(&signal, 0, &m, None, &mut out).is_err());
-    assert!(expose_frame(&signal[..W * H - 1], W, &m, None, &mut out[..W * H - 1]).is_err());
+    assert!(expose_frame(&signal, W, &m, None::<&mut NoiseField>, &mut short).is_err());
+    assert!(expose_frame(&signal, 0, &m, None::<&mut NoiseField>, &mut out).is_err());
+    assert!(
+        expose_frame(
+            &signal[..W * H - 1],
+            W,
+            &m,
+            None::<&mut NoiseField>,
+            &mut out[..W * H - 1]
+        )
+        .is_err()
+    );
     let mut narrow = NoiseField::new(loud, 4.0, 100, 9).unwrap();
     assert!(expose_frame(&signal, W, &m, Some(&mut narrow), &mut out).is_err());
 }

@@ -9,9 +9,12 @@
 //! their prefix sums along the row: scratch memory is O(width), never O(pixels).
 
 use super::{BoxRule, DetectError, Detector, Scratch};
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
+use crate::frame::Frame;
 
-/// Largest block side accepted, in pixels (the whole height of a reference frame).
+/// Largest block side accepted, in pixels (the whole height of a reference frame),
+/// at every capacity: a window sum is at most `249² · 65 535 < 2^32`, so the wrapping
+/// `u32` prefix differences are exact (a side above 255 could overflow them).
 pub const MAX_BLOCK: u16 = 2 * (crate::frame::FRAME_HEIGHT as u16 / 2) + 1;
 
 /// Parameters of the adaptive-threshold detector.
@@ -37,36 +40,33 @@ impl Default for Adaptive {
     }
 }
 
-/// Adaptive thresholding's buffers: one column sum per column and a mask row.
+/// Adaptive thresholding's buffers at capacity `C`: one column sum per column and a
+/// mask row.
 #[derive(Debug, Clone)]
-pub struct AdaptiveWork {
-    /// Sum of each column over the rows of the current block (≤ 248 · 65 535).
-    column_sum: [u32; FRAME_WIDTH],
+pub struct AdaptiveWork<C: FrameCapacity = Reference> {
+    /// Sum of each column over the rows of the current block (≤ min(block, H) ·
+    /// 65 535 ≤ 249 · 65 535 < 2^32).
+    column_sum: C::Row<u32>,
     /// Prefix sums of `column_sum` along the row (`prefix[x]` = sum of columns < x),
-    /// modulo 2^32: any window's sum (≤ 249² · 65 535 < 2^32) is the exact wrapping
-    /// difference of two of them.
-    prefix: [u32; FRAME_WIDTH + 1],
-    mask: [bool; FRAME_WIDTH],
+    /// modulo 2^32: any window's sum (≤ 249² · 65 535 < 2^32, [`MAX_BLOCK`]) is the
+    /// exact wrapping difference of two of them.
+    prefix: C::RowPlus1<u32>,
+    mask: C::Row<bool>,
 }
 
-/// The adaptive detector's scratch memory.
-pub type AdaptiveScratch = Scratch<AdaptiveWork>;
+impl<C: FrameCapacity> ConstInit for AdaptiveWork<C> {
+    const INIT: Self = AdaptiveWork {
+        column_sum: ConstInit::INIT,
+        prefix: ConstInit::INIT,
+        mask: ConstInit::INIT,
+    };
+}
 
-/// Bytes of [`AdaptiveScratch`] (budget: 16 KiB).
+/// The adaptive detector's scratch memory at capacity `C` (default 328×248).
+pub type AdaptiveScratch<C = Reference> = Scratch<AdaptiveWork<C>, C>;
+
+/// Bytes of [`AdaptiveScratch`] at 328×248 (budget: 16 KiB).
 pub const SCRATCH_BYTES: usize = core::mem::size_of::<AdaptiveScratch>();
-
-impl AdaptiveScratch {
-    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
-    pub const fn new() -> Self {
-        Scratch::from_work(<Adaptive as Detector>::WORK)
-    }
-}
-
-impl Default for AdaptiveScratch {
-    fn default() -> Self {
-        Self::new()
-    }
-}
 
 /// The parameters as `name=value` pairs separated by spaces (as in tuning reports
 /// and tuned sets).
@@ -81,13 +81,8 @@ impl core::fmt::Display for Adaptive {
 }
 
 impl Detector for Adaptive {
-    type Work = AdaptiveWork;
+    type Work<C: FrameCapacity> = AdaptiveWork<C>;
     const NAME: &'static str = "adaptive";
-    const WORK: AdaptiveWork = AdaptiveWork {
-        column_sum: [0; FRAME_WIDTH],
-        prefix: [0; FRAME_WIDTH + 1],
-        mask: [false; FRAME_WIDTH],
-    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if self.block < 3 || self.block > MAX_BLOCK || self.block % 2 == 0 {
@@ -109,19 +104,19 @@ impl Detector for Adaptive {
 
     /// Foreground: `DN > block mean + offset_dn`. Threshold: `offset_dn` (as `u32`,
     /// 0 when negative).
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut AdaptiveWork,
+        work: &mut AdaptiveWork<C>,
         mut sink: F,
     ) -> u32 {
         let (w, h) = (frame.width(), frame.height());
         let r = usize::from(self.block / 2);
         let max_dn = frame.max_dn();
         let offset = i64::from(self.offset_dn);
-        let col = &mut work.column_sum[..w];
-        let mask = &mut work.mask[..w];
-        let prefix = &mut work.prefix[..=w];
+        let col = &mut work.column_sum.as_mut()[..w];
+        let mask = &mut work.mask.as_mut()[..w];
+        let prefix = &mut work.prefix.as_mut()[..=w];
         prefix[0] = 0;
         // With |v − offset| ≤ max_dn + |offset| and count ≤ block², i32 suffices when
         // their product does (sums are at most count · max_dn, smaller still).

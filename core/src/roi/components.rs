@@ -11,12 +11,16 @@
 //!   `auto`'s cell box and summed steps.
 //!
 //! Capacities are the users' (fixed arrays, no heap): `L` labels index a parent table
-//! of `P` entries and a statistics table of `N` entries. They differ for `auto`: its
+//! `P` (an array of `L`) and a statistics table `N` (an array of `S`). They differ for `auto`: its
 //! labels are `u8`, so a parent table of all 256 `u8` values needs no bounds check,
 //! while its statistics table holds only the labels it hands out.
 
+use core::marker::PhantomData;
+
+use crate::capacity::{Buffer, ConstInit};
+
 /// A component label: an index into the tables.
-pub(crate) trait Label: Copy + Eq + Ord {
+pub(crate) trait Label: Copy + Eq + Ord + core::fmt::Debug + ConstInit {
     /// The label as a table index.
     fn index(self) -> usize;
 }
@@ -27,69 +31,67 @@ impl Label for u8 {
     }
 }
 
-impl Label for u16 {
-    fn index(self) -> usize {
-        usize::from(self)
-    }
-}
-
 /// Statistics of one component, merged when two components join.
-pub(crate) trait Stats: Copy {
+pub(crate) trait Stats: Copy + core::fmt::Debug + ConstInit {
     /// Adds `other`'s statistics to `self`'s.
     fn merge(&mut self, other: &Self);
 }
 
-/// A union-find forest of at most `N` components (labels `0..N`) with statistics `S`,
-/// and a parent table of `P ≥ N` entries.
+/// A union-find forest of at most `N` components (labels `0..N`, `N` the length of
+/// the statistics table `T`) with statistics `S`, and a parent table `P` of at least
+/// `N` entries.
 #[derive(Debug, Clone)]
-pub(crate) struct Components<L, S, const P: usize, const N: usize> {
+pub(crate) struct Components<L, S, P, T> {
     /// Parent of each label; a root is its own parent. Entries the user marks free hold
-    /// a value outside `0..P`.
-    parent: [L; P],
+    /// a value outside the table.
+    parent: P,
     /// Statistics of each label (meaningful at roots).
-    stats: [S; N],
+    stats: T,
+    _types: PhantomData<(L, S)>,
 }
 
-impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> {
-    /// A table with every parent `parent` and every statistic `stats`.
-    pub const fn new(parent: L, stats: S) -> Self {
-        Components {
-            parent: [parent; P],
-            stats: [stats; N],
-        }
-    }
+impl<L, S, P: ConstInit, T: ConstInit> ConstInit for Components<L, S, P, T> {
+    /// Every parent `L::INIT` (the user's "free" or "no label") and every statistic
+    /// `S::INIT`.
+    const INIT: Self = Components {
+        parent: P::INIT,
+        stats: T::INIT,
+        _types: PhantomData,
+    };
+}
 
+impl<L: Label, S: Stats, P: Buffer<L>, T: Buffer<S>> Components<L, S, P, T> {
     /// The parent of `l` (`None` outside the table).
     pub fn parent(&self, l: usize) -> Option<L> {
-        self.parent.get(l).copied()
+        self.parent.as_ref().get(l).copied()
     }
 
     /// The parent table.
-    pub fn parents(&self) -> &[L; P] {
+    pub fn parents(&self) -> &P {
         &self.parent
     }
 
     /// Sets the parent of `l` (ignored outside the table).
     pub fn set_parent(&mut self, l: usize, p: L) {
-        if let Some(e) = self.parent.get_mut(l) {
+        if let Some(e) = self.parent.as_mut().get_mut(l) {
             *e = p;
         }
     }
 
     /// The statistics of `l` (`None` outside the table).
     pub fn stats(&self, l: usize) -> Option<&S> {
-        self.stats.get(l)
+        self.stats.as_ref().get(l)
     }
 
     /// The statistics of `l`, to update (`None` outside the table).
     pub fn stats_mut(&mut self, l: usize) -> Option<&mut S> {
-        self.stats.get_mut(l)
+        self.stats.as_mut().get_mut(l)
     }
 
     /// Makes `l` a new root with statistics `stats`.
     pub fn make_set(&mut self, l: L, stats: S) {
         self.set_parent(l.index(), l);
-        if let Some(s) = self.stats.get_mut(l.index()) {
+        if let Some(s) = self.stats.as_mut().get_mut(l.index()) {
             *s = stats;
         }
     }
@@ -98,17 +100,18 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
     /// its grandparent). A label whose parent lies outside the table (a free entry) is
     /// its own root.
     pub fn find(&mut self, mut l: L) -> L {
+        let parent = self.parent.as_mut();
         loop {
-            let Some(&p) = self.parent.get(l.index()) else {
+            let Some(&p) = parent.get(l.index()) else {
                 return l;
             };
             if p == l {
                 return l;
             }
-            let Some(&g) = self.parent.get(p.index()) else {
+            let Some(&g) = parent.get(p.index()) else {
                 return l;
             };
-            self.parent[l.index()] = g;
+            parent[l.index()] = g;
             l = p;
         }
     }
@@ -121,8 +124,9 @@ impl<L: Label, S: Stats, const P: usize, const N: usize> Components<L, S, P, N> 
         }
         let (keep, gone) = if a < b { (a, b) } else { (b, a) };
         self.set_parent(gone.index(), keep);
-        if let (Some(&g), true) = (self.stats.get(gone.index()), keep.index() < N) {
-            self.stats[keep.index()].merge(&g);
+        let stats = self.stats.as_mut();
+        if let (Some(&g), true) = (stats.get(gone.index()), keep.index() < stats.len()) {
+            stats[keep.index()].merge(&g);
         }
         keep
     }

@@ -24,15 +24,14 @@
 //! Memory is six 82×62 `u16` planes (base, blur temporary, four levels) plus the blob
 //! list and the mask-to-box state: see [`SCRATCH_BYTES`].
 
-use super::plane::{BLOCK, PLANE_CELLS, Window, block_means};
+use super::plane::{BLOCK, Window, block_means};
 pub use super::plane::{PLANE_HEIGHT, PLANE_WIDTH};
 use super::{BoxRule, DetectError, Detector, Scratch};
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
+use crate::frame::Frame;
 
 /// Block side of the downsampling, in pixels.
 pub const DOWNSAMPLE: usize = BLOCK;
-const PLANE: usize = PLANE_CELLS;
-const HALF_PLANE: usize = PLANE_WIDTH.div_ceil(2) * PLANE_HEIGHT.div_ceil(2);
 /// Levels with σ of at least this many plane pixels are blurred on the half plane
 /// and brought back bilinearly: a fraction of the cost, for Gaussians far wider than
 /// the half plane's pixels.
@@ -49,7 +48,7 @@ pub const MAX_BLOBS: usize = 64;
 /// Lanes of the blur's dot product (taps are padded to a multiple).
 const LANES: usize = 8;
 /// Kernel taps with padding.
-const KERNEL_CAPACITY: usize = (2 * MAX_RADIUS + 1).next_multiple_of(LANES);
+pub(crate) const KERNEL_CAPACITY: usize = (2 * MAX_RADIUS + 1).next_multiple_of(LANES);
 /// Fixed-point scale of the kernel weights (Q15).
 const ONE_Q15: u32 = 1 << 15;
 /// Fixed-point scale of the response normalisation 1/(k − 1) (Q4).
@@ -104,45 +103,54 @@ const NO_BLOB: Blob = Blob {
     response: 0,
 };
 
-/// DoG's buffers.
+/// DoG's buffers at capacity `C` (`PW × PH` cells of 4×4 pixels). Plane values are
+/// means of DN (`u16`), block sums at most `16 · 65 535`, responses
+/// `(G_i − G_{i+1})·16/(k − 1) ≤ 65 535 · 16 000 < 2^31` and blur accumulators
+/// `Σ w·v ≤ 2^15 · 2^15`: none depends on the capacity.
 #[derive(Debug, Clone)]
-pub struct DogWork {
-    base: [u16; PLANE],
+pub struct DogWork<C: FrameCapacity = Reference> {
+    base: C::Cells<u16>,
     /// 2×2 means of the first level with σ ≥ [`HALVE_SIGMA`], for the coarse levels.
-    half: [u16; HALF_PLANE],
+    half: C::HalfCells<u16>,
     /// σ of the level in `half`, in plane pixels (0: none yet this frame).
     half_sigma: f32,
-    tmp: [u16; PLANE],
-    ring: [[u16; PLANE]; 4],
-    row_sum: [u32; PLANE_WIDTH],
-    pad: [i16; PLANE_WIDTH + KERNEL_CAPACITY],
+    tmp: C::Cells<u16>,
+    ring: [C::Cells<u16>; 4],
+    row_sum: C::CellRow<u32>,
+    /// A row (or, transposed, a column) of cells plus the kernel's padding.
+    pad: C::PaddedCellRow<i16>,
     kernel: [i16; 2 * MAX_RADIUS + 1],
     blobs: [Blob; MAX_BLOBS],
     blob_count: usize,
-    mask: [bool; FRAME_WIDTH],
+    mask: C::Row<bool>,
 }
 
-/// The DoG detector's scratch memory.
-pub type DogScratch = Scratch<DogWork>;
+impl<C: FrameCapacity> ConstInit for DogWork<C> {
+    const INIT: Self = DogWork {
+        base: ConstInit::INIT,
+        half: ConstInit::INIT,
+        half_sigma: 0.0,
+        tmp: ConstInit::INIT,
+        ring: [ConstInit::INIT; 4],
+        row_sum: ConstInit::INIT,
+        pad: ConstInit::INIT,
+        kernel: [0; 2 * MAX_RADIUS + 1],
+        blobs: [NO_BLOB; MAX_BLOBS],
+        blob_count: 0,
+        mask: ConstInit::INIT,
+    };
+}
 
-/// Bytes of [`DogScratch`] (budget: 96 KiB).
+/// The DoG detector's scratch memory at capacity `C` (default 328×248).
+pub type DogScratch<C = Reference> = Scratch<DogWork<C>, C>;
+
+/// Bytes of [`DogScratch`] at 328×248 (budget: 96 KiB).
 pub const SCRATCH_BYTES: usize = core::mem::size_of::<DogScratch>();
 
-impl DogScratch {
-    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
-    pub const fn new() -> Self {
-        Scratch::from_work(<Dog as Detector>::WORK)
-    }
-
+impl<C: FrameCapacity> DogScratch<C> {
     /// The blobs of the last [`Detector::detect`] call, strongest not first.
     pub fn blobs(&self) -> &[Blob] {
         &self.work.blobs[..self.work.blob_count]
-    }
-}
-
-impl Default for DogScratch {
-    fn default() -> Self {
-        Self::new()
     }
 }
 
@@ -242,21 +250,8 @@ impl core::fmt::Display for Dog {
 }
 
 impl Detector for Dog {
-    type Work = DogWork;
+    type Work<C: FrameCapacity> = DogWork<C>;
     const NAME: &'static str = "dog";
-    const WORK: DogWork = DogWork {
-        base: [0; PLANE],
-        half: [0; HALF_PLANE],
-        half_sigma: 0.0,
-        tmp: [0; PLANE],
-        ring: [[0; PLANE]; 4],
-        row_sum: [0; PLANE_WIDTH],
-        pad: [0; PLANE_WIDTH + KERNEL_CAPACITY],
-        kernel: [0; 2 * MAX_RADIUS + 1],
-        blobs: [NO_BLOB; MAX_BLOBS],
-        blob_count: 0,
-        mask: [false; FRAME_WIDTH],
-    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if !(self.sigma0_px.is_finite() && self.sigma0_px >= 1.0) {
@@ -297,10 +292,10 @@ impl Detector for Dog {
     }
 
     /// Foreground: the union of the blob squares. Threshold: `min_response_dn`.
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut DogWork,
+        work: &mut DogWork<C>,
         mut sink: F,
     ) -> u32 {
         let (w, h) = (frame.width(), frame.height());
@@ -308,8 +303,8 @@ impl Detector for Dog {
         block_means(
             frame,
             Window::full(frame),
-            &mut work.row_sum,
-            &mut work.base,
+            work.row_sum.as_mut(),
+            work.base.as_mut(),
         );
         find_blobs(self, work, pw, ph);
 
@@ -326,7 +321,7 @@ impl Detector for Dog {
             );
         }
         let squares = &squares[..work.blob_count];
-        let mask = &mut work.mask[..w];
+        let mask = &mut work.mask.as_mut()[..w];
         for y in 0..h {
             mask.fill(false);
             for &(x0, y0, x1, y1) in squares {
@@ -341,7 +336,7 @@ impl Detector for Dog {
 }
 
 /// Gaussian level `i` into ring slot `i % 4`.
-fn gaussian_level(dog: &Dog, work: &mut DogWork, i: u8, pw: usize, ph: usize) {
+fn gaussian_level<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, i: u8, pw: usize, ph: usize) {
     let sigma = dog.sigma_px(i) / DOWNSAMPLE as f32;
     let n = pw * ph;
     let slot = usize::from(i) % 4;
@@ -357,25 +352,27 @@ fn gaussian_level(dog: &Dog, work: &mut DogWork, i: u8, pw: usize, ph: usize) {
         let radius = libm::ceilf(3.0 * sigma_half) as usize;
         let r = gaussian_kernel(sigma_half.max(0.25), radius, &mut work.kernel);
         let kernel = &work.kernel[..2 * r + 1];
-        let (across, down) = work.tmp.split_at_mut(m);
-        blur_rows_transposed(&work.half[..m], across, hw, kernel, &mut work.pad);
-        blur_rows_transposed(across, &mut down[..m], hh, kernel, &mut work.pad);
-        upsample(&down[..m], hw, &mut work.ring[slot][..n], pw);
+        let (across, down) = work.tmp.as_mut().split_at_mut(m);
+        let pad = work.pad.as_mut();
+        blur_rows_transposed(&work.half.as_ref()[..m], across, hw, kernel, pad);
+        blur_rows_transposed(across, &mut down[..m], hh, kernel, pad);
+        upsample(&down[..m], hw, &mut work.ring[slot].as_mut()[..n], pw);
         return;
     }
     let r = gaussian_kernel(sigma, dog.radius_plane(i), &mut work.kernel);
     let kernel = &work.kernel[..2 * r + 1];
+    let pad = work.pad.as_mut();
     blur_rows_transposed(
-        &work.base[..n],
-        &mut work.tmp[..n],
+        &work.base.as_ref()[..n],
+        &mut work.tmp.as_mut()[..n],
         pw,
         kernel,
-        &mut work.pad,
+        pad,
     );
-    let dst = &mut work.ring[slot][..n];
-    blur_rows_transposed(&work.tmp[..n], dst, ph, kernel, &mut work.pad);
+    let dst = &mut work.ring[slot].as_mut()[..n];
+    blur_rows_transposed(&work.tmp.as_ref()[..n], dst, ph, kernel, pad);
     if sigma >= HALVE_SIGMA && work.half_sigma == 0.0 {
-        halve(&work.ring[slot][..n], pw, &mut work.half);
+        halve(&work.ring[slot].as_ref()[..n], pw, work.half.as_mut());
         work.half_sigma = sigma;
     }
 }
@@ -426,7 +423,7 @@ fn upsample(src: &[u16], hw: usize, dst: &mut [u16], pw: usize) {
 }
 
 /// Scale-space maxima of the normalised DoG into `work.blobs`.
-fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
+fn find_blobs<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, pw: usize, ph: usize) {
     work.blob_count = 0;
     let levels = dog.levels;
     let layers_total = levels - 1;
@@ -453,8 +450,8 @@ fn find_blobs(dog: &Dog, work: &mut DogWork, pw: usize, ph: usize) {
         // Layer l is (G_l − G_{l+1})·norm; its two planes come from the ring.
         let planes = |l: u8| {
             (
-                &ring[usize::from(l) % 4][..n],
-                &ring[usize::from(l + 1) % 4][..n],
+                &ring[usize::from(l) % 4].as_ref()[..n],
+                &ring[usize::from(l + 1) % 4].as_ref()[..n],
                 norm,
             )
         };
@@ -520,7 +517,7 @@ mod tests {
     use super::*;
 
     /// A plane with edges, texture and noise (deterministic), 82×62.
-    fn test_plane() -> [u16; PLANE] {
+    fn test_plane() -> [u16; PLANE_WIDTH * PLANE_HEIGHT] {
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         core::array::from_fn(|i| {
             state ^= state << 13;
@@ -563,7 +560,7 @@ mod tests {
     fn decimated_levels_match_direct_blur() {
         let dog = Dog::default();
         let (pw, ph) = (PLANE_WIDTH, PLANE_HEIGHT);
-        let mut work = DogScratch::new().work;
+        let mut work = DogScratch::<Reference>::new().work;
         work.base = test_plane();
         work.half_sigma = 0.0;
         let range = f32::from(work.base.iter().max().unwrap() - work.base.iter().min().unwrap());
@@ -579,7 +576,7 @@ mod tests {
             let kernel = work.kernel;
             let kernel = &kernel[..2 * r + 1];
             blur_rows_transposed(&work.base, &mut work.tmp, pw, kernel, &mut work.pad);
-            let mut direct = [0u16; PLANE];
+            let mut direct = [0u16; PLANE_WIDTH * PLANE_HEIGHT];
             blur_rows_transposed(&work.tmp, &mut direct, ph, kernel, &mut work.pad);
             let margin = libm::ceilf(sigma) as usize;
             let (mut inner, mut edge) = (0u32, 0u32);

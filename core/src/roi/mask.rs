@@ -5,26 +5,47 @@
 //! previous and the current row, and a table of the components they touch. A
 //! component that no run of the current row continues is complete; it is compared
 //! with the best so far and its table entry is freed. Memory is therefore bounded by
-//! the number of runs a row can hold (164 on a 328-pixel row), not by the frame.
+//! the number of runs a row can hold (`⌈W/2⌉` for a capacity `W` pixels wide: 164 on a
+//! 328-pixel row), not by the frame.
+//!
+//! Bounds (capacity `W × H`, both below 65 535 by [`crate::capacity`]): run ends `≤ W`
+//! and component labels `< 2·⌈W/2⌉` fit `u16`, and so do row stamps `< H`; a
+//! component's area and its first pixel's raster index `y·width + x` are below
+//! `W·H ≤ 1024 · 768`, far inside `u32`.
 
-use super::components::{Components, Stats};
+use super::components::{Components, Label, Stats};
 use super::{BoxRule, Roi};
-use crate::frame::FRAME_WIDTH;
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
 
-/// Most runs a row of [`FRAME_WIDTH`] pixels can hold (foreground, gap, foreground, ...).
-const MAX_RUNS: usize = FRAME_WIDTH.div_ceil(2);
-/// Components open at once (the table is reused as components complete): those of
-/// the previous row plus new ones of this row, at most [`MAX_RUNS`] each: 328.
-const MAX_OPEN_COMPONENTS: usize = 2 * MAX_RUNS;
+/// A component label of the run table (`u16`; [`FREE`] marks a free entry, and is
+/// what a fresh table holds).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct RunLabel(u16);
+
+impl Label for RunLabel {
+    #[inline(always)]
+    fn index(self) -> usize {
+        usize::from(self.0)
+    }
+}
+
+impl ConstInit for RunLabel {
+    const INIT: Self = FREE;
+}
+
 /// Marks a free component-table entry (as its parent, outside the table).
-const FREE: u16 = u16::MAX;
+const FREE: RunLabel = RunLabel(u16::MAX);
 
 /// A horizontal run of foreground pixels `[x0, x1)` and its component label.
 #[derive(Debug, Clone, Copy)]
 struct Run {
     x0: u16,
     x1: u16,
-    label: u16,
+    label: RunLabel,
+}
+
+impl ConstInit for Run {
+    const INIT: Self = NO_RUN;
 }
 
 const NO_RUN: Run = Run {
@@ -50,6 +71,10 @@ const NO_PIXELS: RunStats = RunStats {
     first: u32::MAX,
 };
 
+impl ConstInit for RunStats {
+    const INIT: Self = NO_PIXELS;
+}
+
 impl RunStats {
     /// True when `self` beats `other` (no component yet: `None`) as the largest
     /// component.
@@ -67,14 +92,22 @@ impl Stats for RunStats {
     }
 }
 
-/// The open components: `u16` labels, one entry per open component.
-type RunComponents = Components<u16, RunStats, MAX_OPEN_COMPONENTS, MAX_OPEN_COMPONENTS>;
+/// The open components of capacity `C`: `u16` labels, one entry per open component
+/// (those of the previous row plus new ones of this row, at most `⌈W/2⌉` each).
+type RunComponents<C> = Components<
+    RunLabel,
+    RunStats,
+    <C as FrameCapacity>::OpenComponents<RunLabel>,
+    <C as FrameCapacity>::OpenComponents<RunStats>,
+>;
 
-/// Turns a foreground mask, pushed one row at a time, into a box and a pixel count.
+/// Turns a foreground mask, pushed one row at a time, into a box and a pixel count,
+/// for frames up to capacity `C` (default: the reference 328×248).
 ///
-/// Memory: about 8.5 KiB, fixed; part of every detector's [`super::Scratch`].
+/// Memory: about 8.5 KiB at 328×248, linear in the capacity's width; part of every
+/// detector's [`super::Scratch`].
 #[derive(Debug, Clone)]
-pub struct RoiBuilder {
+pub struct RoiBuilder<C: FrameCapacity = Reference> {
     rule: BoxRule,
     width: usize,
     /// Row expected next; rows must come in order.
@@ -84,50 +117,59 @@ pub struct RoiBuilder {
     hull: Roi,
     /// The runs of the previous and of the current row, alternately (`cur_side`
     /// says which is current, so finishing a row swaps an index, not the arrays).
-    runs: [[Run; MAX_RUNS]; 2],
+    runs: [C::Runs<Run>; 2],
     cur_side: usize,
     prev_len: usize,
     cur_len: usize,
     /// The open components (union-find; a free entry's parent is [`FREE`]).
-    table: RunComponents,
+    table: RunComponents<C>,
     /// Per table entry: the last row in which a run of the component was seen.
-    seen_row: [u16; MAX_OPEN_COMPONENTS],
+    seen_row: C::OpenComponents<u16>,
     /// One past the highest table entry in use.
     table_high: usize,
     /// The largest complete component so far.
     best: Option<RunStats>,
 }
 
-impl Default for RoiBuilder {
+impl<C: FrameCapacity> Default for RoiBuilder<C> {
     fn default() -> Self {
-        Self::new()
+        Self::for_capacity()
     }
 }
 
 impl RoiBuilder {
-    /// An idle builder (call [`RoiBuilder::start`] before pushing rows).
+    /// An idle builder of the reference capacity, 328×248 (call
+    /// [`RoiBuilder::start`] before pushing rows).
     pub const fn new() -> Self {
+        Self::for_capacity()
+    }
+}
+
+impl<C: FrameCapacity> RoiBuilder<C> {
+    /// An idle builder of capacity `C` (call [`RoiBuilder::start`] before pushing rows).
+    pub const fn for_capacity() -> Self {
         RoiBuilder {
             rule: BoxRule::AllForeground,
             width: 0,
             next_row: 0,
             foreground_px: 0,
             hull: Roi::EMPTY,
-            runs: [[NO_RUN; MAX_RUNS]; 2],
+            runs: [ConstInit::INIT; 2],
             cur_side: 0,
             prev_len: 0,
             cur_len: 0,
-            table: RunComponents::new(FREE, NO_PIXELS),
-            seen_row: [0; MAX_OPEN_COMPONENTS],
+            table: ConstInit::INIT,
+            seen_row: ConstInit::INIT,
             table_high: 0,
             best: None,
         }
     }
 
-    /// Starts a frame `width` pixels wide (at most [`FRAME_WIDTH`]; wider rows are cut).
+    /// Starts a frame `width` pixels wide (at most the capacity's width; wider rows
+    /// are cut: the detectors refuse such frames before).
     pub fn start(&mut self, rule: BoxRule, width: usize) {
         self.rule = rule;
-        self.width = width.min(FRAME_WIDTH);
+        self.width = width.min(C::WIDTH);
         self.next_row = 0;
         self.foreground_px = 0;
         self.hull = Roi::EMPTY;
@@ -202,7 +244,7 @@ impl RoiBuilder {
         self.cur_len = 0;
     }
 
-    /// Splits the mask row into runs (at most [`MAX_RUNS`] fit any row of the width).
+    /// Splits the mask row into runs (at most `⌈W/2⌉` fit any row of the width).
     fn collect_runs(&mut self, x0: usize, mask: &[bool]) {
         self.cur_len = 0;
         let mut x = 0;
@@ -215,7 +257,7 @@ impl RoiBuilder {
             while x < mask.len() && mask[x] {
                 x += 1;
             }
-            if let Some(run) = self.runs[self.cur_side].get_mut(self.cur_len) {
+            if let Some(run) = self.runs[self.cur_side].as_mut().get_mut(self.cur_len) {
                 *run = Run {
                     x0: (x0 + start) as u16,
                     x1: (x0 + x) as u16,
@@ -230,18 +272,19 @@ impl RoiBuilder {
     /// the 8-connected runs above it, or a new one.
     fn link_runs(&mut self, y: usize) {
         let mut j0 = 0;
-        let (c, p) = (self.cur_side, 1 - self.cur_side);
+        let c = self.cur_side;
+        let p = 1 - c;
         for i in 0..self.cur_len {
-            let run = self.runs[c][i];
+            let run = self.runs[c].as_ref()[i];
             // Runs above that end left of this run's left neighbour can no longer touch
             // this or any later run.
-            while j0 < self.prev_len && self.runs[p][j0].x1 < run.x0 {
+            while j0 < self.prev_len && self.runs[p].as_ref()[j0].x1 < run.x0 {
                 j0 += 1;
             }
             let mut label = FREE;
             let mut j = j0;
-            while j < self.prev_len && self.runs[p][j].x0 <= run.x1 {
-                let root = self.table.find(self.runs[p][j].label);
+            while j < self.prev_len && self.runs[p].as_ref()[j].x0 <= run.x1 {
+                let root = self.table.find(self.runs[p].as_ref()[j].label);
                 label = if label == FREE {
                     root
                 } else {
@@ -250,7 +293,7 @@ impl RoiBuilder {
                 j += 1;
             }
             if label == FREE {
-                match self.alloc() {
+                match alloc::<C>(&mut self.table, &mut self.seen_row, &mut self.table_high) {
                     Some(l) => label = l,
                     // Unreachable by the capacity argument (at most MAX_RUNS components
                     // survive a row, at most MAX_RUNS are born in one); drop the run
@@ -259,13 +302,13 @@ impl RoiBuilder {
                 }
             }
             let width = self.width as u32;
-            if let Some(comp) = self.table.stats_mut(usize::from(label)) {
+            if let Some(comp) = self.table.stats_mut(label.index()) {
                 let run_roi = Roi::new(run.x0, y as u16, run.x1, y as u16 + 1);
                 comp.roi = comp.roi.hull(&run_roi);
                 comp.area += u32::from(run.x1 - run.x0);
                 comp.first = comp.first.min(y as u32 * width + u32::from(run.x0));
             }
-            self.runs[c][i].label = label;
+            self.runs[c].as_mut()[i].label = label;
         }
     }
 
@@ -275,9 +318,10 @@ impl RoiBuilder {
         let stamp = y as u16;
         let c = self.cur_side;
         for i in 0..self.cur_len {
-            let root = self.table.find(self.runs[c][i].label);
-            self.runs[c][i].label = root;
-            if let Some(seen) = self.seen_row.get_mut(usize::from(root)) {
+            let run = &mut self.runs[c].as_mut()[i];
+            let root = self.table.find(run.label);
+            run.label = root;
+            if let Some(seen) = self.seen_row.as_mut().get_mut(root.index()) {
                 *seen = stamp;
             }
         }
@@ -287,8 +331,8 @@ impl RoiBuilder {
                 continue;
             };
             let c = *self.table.stats(k).unwrap_or(&NO_PIXELS);
-            let is_root = usize::from(parent) == k;
-            if is_root && self.seen_row[k] == stamp && c.area > 0 {
+            let is_root = parent.index() == k;
+            if is_root && self.seen_row.as_ref()[k] == stamp && c.area > 0 {
                 high = k + 1;
                 continue;
             }
@@ -306,19 +350,24 @@ impl RoiBuilder {
         if let Some(s) = self.table.stats_mut(k) {
             *s = NO_PIXELS;
         }
-        if let Some(seen) = self.seen_row.get_mut(k) {
+        if let Some(seen) = self.seen_row.as_mut().get_mut(k) {
             *seen = 0;
         }
     }
+}
 
-    /// A free table entry, as a new root with no pixels yet.
-    fn alloc(&mut self) -> Option<u16> {
-        let k = self.table.parents().iter().position(|&p| p == FREE)?;
-        self.table.make_set(k as u16, NO_PIXELS);
-        self.seen_row[k] = 0;
-        self.table_high = self.table_high.max(k + 1);
-        Some(k as u16)
-    }
+/// A free entry of `table`, as a new root with no pixels yet.
+fn alloc<C: FrameCapacity>(
+    table: &mut RunComponents<C>,
+    seen_row: &mut C::OpenComponents<u16>,
+    table_high: &mut usize,
+) -> Option<RunLabel> {
+    let k = table.parents().as_ref().iter().position(|&p| p == FREE)?;
+    let label = RunLabel(k as u16);
+    table.make_set(label, NO_PIXELS);
+    seen_row.as_mut()[k] = 0;
+    *table_high = (*table_high).max(k + 1);
+    Some(label)
 }
 
 /// Bits of 16 mask pixels, pixel `i` in bit `i` (compiles to one `pmovmskb` on x86).

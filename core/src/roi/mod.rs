@@ -18,7 +18,7 @@
 mod bbox;
 mod components;
 mod mask;
-mod plane;
+pub(crate) mod plane;
 pub mod registry;
 
 pub mod adaptive;
@@ -32,6 +32,7 @@ use core::fmt;
 pub use bbox::Roi;
 pub use mask::RoiBuilder;
 
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
 use crate::frame::Frame;
 
 /// How a foreground mask becomes one box.
@@ -98,6 +99,37 @@ pub enum DetectError {
         /// What the bounds are.
         expected: &'static str,
     },
+    /// The frame is larger than the capacity of the detector's scratch
+    /// ([`FrameCapacity`]): use a scratch of a larger capacity.
+    FrameTooLarge {
+        /// Frame width, pixels.
+        width: usize,
+        /// Frame height, pixels.
+        height: usize,
+        /// Largest width the scratch holds.
+        capacity_width: usize,
+        /// Largest height the scratch holds.
+        capacity_height: usize,
+    },
+}
+
+impl DetectError {
+    /// `Ok` when `frame` fits capacity `C`, else [`DetectError::FrameTooLarge`].
+    ///
+    /// # Errors
+    /// [`DetectError::FrameTooLarge`] when the frame is wider or taller than `C`.
+    #[inline]
+    pub fn check_capacity<C: FrameCapacity>(frame: &Frame<'_>) -> Result<(), DetectError> {
+        if frame.width() > C::WIDTH || frame.height() > C::HEIGHT {
+            return Err(DetectError::FrameTooLarge {
+                width: frame.width(),
+                height: frame.height(),
+                capacity_width: C::WIDTH,
+                capacity_height: C::HEIGHT,
+            });
+        }
+        Ok(())
+    }
 }
 
 impl fmt::Display for DetectError {
@@ -106,28 +138,54 @@ impl fmt::Display for DetectError {
             DetectError::InvalidParameter { name, expected } => {
                 write!(f, "invalid parameter `{name}`: expected {expected}")
             }
+            DetectError::FrameTooLarge {
+                width,
+                height,
+                capacity_width,
+                capacity_height,
+            } => write!(
+                f,
+                "frame is {width}x{height} px, larger than the {capacity_width}x{capacity_height} px capacity of the detector's scratch"
+            ),
         }
     }
 }
 
-/// A detector's whole working memory: its own buffers `W` and the mask-to-box state.
+/// A detector's whole working memory at capacity `C`: its own buffers `W` (its
+/// [`Detector::Work`]) and the mask-to-box state.
 ///
-/// Its size is `core::mem::size_of::<Scratch<W>>()`, fixed at compile time; each
-/// detector module exports it as `SCRATCH_BYTES`. Build it once (`Scratch::new()` is a
-/// `const fn`, so it can live in a `static`) and reuse it for every frame.
+/// Its size is `core::mem::size_of::<Scratch<W, C>>()`, fixed at compile time; each
+/// detector module exports the reference capacity's as `SCRATCH_BYTES` and names its
+/// scratch (`OtsuScratch<C = Reference>`, ...). Build it once (`Scratch::new()` for the
+/// reference 328×248, `Scratch::for_capacity()` for another, e.g.
+/// `OtsuScratch::<Cap640x512>::for_capacity()`; both `const fn`, so it can live in a
+/// `static`) and reuse it for every frame up to `C`'s size.
 #[derive(Clone)]
-pub struct Scratch<W> {
+pub struct Scratch<W, C: FrameCapacity = Reference> {
     pub(crate) work: W,
-    pub(crate) roi: RoiBuilder,
+    pub(crate) roi: RoiBuilder<C>,
 }
 
-impl<W> Scratch<W> {
-    /// Scratch around a detector's fresh buffers (see [`Detector::WORK`]).
-    pub const fn from_work(work: W) -> Self {
+impl<W: ConstInit> Scratch<W> {
+    /// Fresh scratch of the reference capacity, 328×248.
+    pub const fn new() -> Self {
+        Self::for_capacity()
+    }
+}
+
+impl<W: ConstInit, C: FrameCapacity> Scratch<W, C> {
+    /// Fresh scratch of capacity `C`.
+    pub const fn for_capacity() -> Self {
         Scratch {
-            work,
-            roi: RoiBuilder::new(),
+            work: W::INIT,
+            roi: RoiBuilder::for_capacity(),
         }
+    }
+}
+
+impl<W: ConstInit, C: FrameCapacity> Default for Scratch<W, C> {
+    fn default() -> Self {
+        Self::for_capacity()
     }
 }
 
@@ -136,16 +194,14 @@ impl<W> Scratch<W> {
 /// A detector's parameter struct implements it together with `Default` (its default
 /// parameters), `Copy` and `Display` (its parameters as `name=value` pairs), and is
 /// registered with one line in the [`registry`].
-pub trait Detector {
-    /// The detector's own buffers (without the mask-to-box state).
-    type Work;
+pub trait Detector: Sized {
+    /// The detector's own buffers (without the mask-to-box state) at capacity `C`;
+    /// fresh ones are [`ConstInit::INIT`] (a constant, so a [`Scratch`] can be built
+    /// in a `const` context).
+    type Work<C: FrameCapacity>: ConstInit + Clone;
 
     /// Short lower-case name, as on the command line (`otsu`, `adaptive`, ...).
     const NAME: &'static str;
-
-    /// Fresh working buffers (a constant, so a [`Scratch`] can be built in a `const`
-    /// context: [`Scratch::from_work`]).
-    const WORK: Self::Work;
 
     /// Checks the parameters against their documented bounds.
     ///
@@ -165,24 +221,27 @@ pub trait Detector {
     /// Computes the foreground mask of `frame` and hands it to `sink` one row at a
     /// time, top to bottom, every row exactly once (`sink(y, mask)` with
     /// `mask.len() == frame.width()`). Returns the threshold used (see
-    /// [`Detection::threshold`]). Parameters must have been validated.
-    fn foreground<F: FnMut(usize, &[bool])>(
+    /// [`Detection::threshold`]). Parameters must have been validated and the frame
+    /// must fit `C` ([`DetectError::check_capacity`]).
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut Self::Work,
+        work: &mut Self::Work<C>,
         sink: F,
     ) -> u32;
 
     /// Runs the detector on `frame` in `scratch`.
     ///
     /// # Errors
-    /// [`DetectError::InvalidParameter`] when [`Detector::validate`] fails.
-    fn detect(
+    /// [`DetectError::InvalidParameter`] when [`Detector::validate`] fails,
+    /// [`DetectError::FrameTooLarge`] when the frame exceeds the scratch's capacity.
+    fn detect<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
-        scratch: &mut Scratch<Self::Work>,
+        scratch: &mut Scratch<Self::Work<C>, C>,
     ) -> Result<Detection, DetectError> {
         self.validate()?;
+        DetectError::check_capacity::<C>(frame)?;
         let Scratch { work, roi } = scratch;
         roi.start(self.box_rule(), frame.width());
         let threshold = self.foreground(frame, work, |y, mask| roi.push_row(y, mask));

@@ -20,7 +20,8 @@
 //! foreground.
 
 use super::{BoxRule, DetectError, Detector, Scratch};
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::capacity::{ConstInit, Counter, FrameCapacity, Reference};
+use crate::frame::Frame;
 
 /// Coarse histogram bins (a bin spans `2^(bits − 7)` DN for bit depths above 7).
 pub const COARSE_BINS: usize = 128;
@@ -41,42 +42,46 @@ pub struct Otsu {
     pub box_rule: BoxRule,
 }
 
-/// Otsu's buffers: the coarse histogram, the refinement counters and a mask row.
+/// Otsu's buffers at capacity `C`: the coarse histogram, the refinement counters and
+/// a mask row.
 #[derive(Debug, Clone)]
-pub struct OtsuWork {
+pub struct OtsuWork<C: FrameCapacity = Reference> {
     /// Per coarse bin and lane: pixel count in the high 32 bits, sum of `v − bin_start`
-    /// in the low 32 (≤ 2^9 · 81 344 < 2^32), so the histogram pass does one add per
-    /// pixel. Lane 0 holds the totals after the pass.
+    /// in the low 32 (≤ (2^9 − 1) · W·H < 2^32 for every capacity, checked in
+    /// [`crate::capacity`]: 4.2·10^7 at 328×248, 4.0·10^8 at 1024×768), so the
+    /// histogram pass does one add per pixel. Lane 0 holds the totals after the pass.
     coarse: [[u64; COARSE_BINS]; LANES],
     /// Pixels per DN of the bins being refined, in two lanes (even and odd pixels;
-    /// each at most 40 672, so `u16` holds them).
-    fine: [[u16; FINE_SLOTS]; 2],
+    /// each at most `⌈W·H/2⌉`: 40 672 at 328×248, so `u16` holds them; capacities of
+    /// more than 131 070 pixels count in `u32`: [`FrameCapacity::FineCount`]).
+    fine: [[C::FineCount; FINE_SLOTS]; 2],
     /// Position of each coarse bin in `fine` (in bins), or [`NOT_REFINED`].
     slot: [u8; COARSE_BINS],
-    mask: [bool; FRAME_WIDTH],
+    mask: C::Row<bool>,
 }
 
-/// The Otsu detector's scratch memory.
-pub type OtsuScratch = Scratch<OtsuWork>;
+impl<C: FrameCapacity> ConstInit for OtsuWork<C> {
+    const INIT: Self = OtsuWork {
+        coarse: [[0; COARSE_BINS]; LANES],
+        fine: [[ConstInit::INIT; FINE_SLOTS]; 2],
+        slot: [NOT_REFINED; COARSE_BINS],
+        mask: ConstInit::INIT,
+    };
+}
 
-/// Bytes of [`OtsuScratch`] (budget: 16 KiB).
+/// The Otsu detector's scratch memory at capacity `C` (default 328×248).
+pub type OtsuScratch<C = Reference> = Scratch<OtsuWork<C>, C>;
+
+/// Bytes of [`OtsuScratch`] at 328×248 (budget: 16 KiB).
 pub const SCRATCH_BYTES: usize = core::mem::size_of::<OtsuScratch>();
-
-impl OtsuScratch {
-    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
-    pub const fn new() -> Self {
-        Scratch::from_work(<Otsu as Detector>::WORK)
-    }
-}
-
-impl Default for OtsuScratch {
-    fn default() -> Self {
-        Self::new()
-    }
-}
 
 /// An exact value of the between-class variance, up to the common factor 1/N⁴:
 /// `d² / den` with `d = M·n₀ − N·m₀` and `den = n₀·(N − n₀)`.
+///
+/// Bounds, for frames up to the largest capacity (N ≤ 1024·768 < 2^20, DN < 2^16):
+/// `|d| = n₀·n₁·|μ₁ − μ₀| ≤ (N²/4)·2^16 < 2^54`, so `d² < 2^108`; `den ≤ N²/4 < 2^38`,
+/// so the cross-multiplied remainders stay below 2^76; the branch-and-bound's
+/// `|d_a| + k·S` (`S ≤ N·2^16`) stays below 2^57. All far inside `u128`/`i128`.
 #[derive(Debug, Clone, Copy)]
 struct Score {
     d2: u128,
@@ -155,7 +160,7 @@ impl Totals {
 
 /// Histogram, boundary scores, branch and bound: a threshold realising the exact
 /// optimum (the mask pass later maps it to the smallest such threshold).
-fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
+fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u16 {
     let max_dn = frame.max_dn();
     let shift = frame.bits().saturating_sub(COARSE_SHIFT_BITS);
     let bin_width = 1usize << shift;
@@ -244,8 +249,8 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
         }
         let [even, odd] = &mut work.fine;
         let used = usize::from(picked) * bin_width;
-        even[..used].fill(0);
-        odd[..used].fill(0);
+        even[..used].fill(ConstInit::INIT);
+        odd[..used].fill(ConstInit::INIT);
         let index = |v: u16| {
             let v = v.min(max_dn);
             let s = slot[usize::from(v >> shift) & (COARSE_BINS - 1)];
@@ -256,18 +261,18 @@ fn otsu_split(frame: &Frame<'_>, work: &mut OtsuWork) -> u16 {
         let mut pairs = frame.pixels().chunks_exact(2);
         for pair in &mut pairs {
             if let Some(i) = index(pair[0]) {
-                even[i] += 1;
+                even[i].increment();
             }
             if let Some(i) = index(pair[1]) {
-                odd[i] += 1;
+                odd[i].increment();
             }
         }
         for &v in pairs.remainder() {
             if let Some(i) = index(v) {
-                even[i] += 1;
+                even[i].increment();
             }
         }
-        let fine = |i: usize| u32::from(even[i]) + u32::from(odd[i]);
+        let fine = |i: usize| even[i].get() + odd[i].get();
         // Exact scores at every DN of the picked bins.
         let (mut n0, mut m0) = (0u64, 0u64);
         for (b, &s) in slot[..bins].iter().enumerate() {
@@ -356,14 +361,8 @@ impl core::fmt::Display for Otsu {
 }
 
 impl Detector for Otsu {
-    type Work = OtsuWork;
+    type Work<C: FrameCapacity> = OtsuWork<C>;
     const NAME: &'static str = "otsu";
-    const WORK: OtsuWork = OtsuWork {
-        coarse: [[0; COARSE_BINS]; LANES],
-        fine: [[0; FINE_SLOTS]; 2],
-        slot: [NOT_REFINED; COARSE_BINS],
-        mask: [false; FRAME_WIDTH],
-    };
 
     fn validate(&self) -> Result<(), DetectError> {
         Ok(())
@@ -379,10 +378,10 @@ impl Detector for Otsu {
 
     /// Foreground: `DN > t`. Threshold: the smallest `t` maximising the between-class
     /// variance, in DN.
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut OtsuWork,
+        work: &mut OtsuWork<C>,
         mut sink: F,
     ) -> u32 {
         let t = otsu_split(frame, work);
@@ -390,7 +389,7 @@ impl Detector for Otsu {
         // The split is the same for every t between the brightest background DN and
         // the darkest foreground DN; report the smallest, as an exhaustive search would.
         let mut brightest_background = 0u16;
-        let mask = &mut work.mask[..frame.width()];
+        let mask = &mut work.mask.as_mut()[..frame.width()];
         for (y, row) in frame.rows().enumerate() {
             for (m, &v) in mask.iter_mut().zip(row) {
                 let v = v.min(max_dn);

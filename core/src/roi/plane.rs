@@ -7,13 +7,11 @@ use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
 
 /// Block side of the downsampled planes, in pixels.
 pub const BLOCK: usize = 4;
-/// Width of a full frame's plane of `BLOCK × BLOCK` cells (82 for 328 pixels): `dog`'s
+/// Width of a full reference frame's plane of `BLOCK × BLOCK` cells (82 for 328 pixels): `dog`'s
 /// block means and `auto`'s step codes.
 pub const PLANE_WIDTH: usize = FRAME_WIDTH.div_ceil(BLOCK);
-/// Height of a full frame's plane of cells (62 for 248 pixels).
+/// Height of a full reference frame's plane of cells (62 for 248 pixels).
 pub const PLANE_HEIGHT: usize = FRAME_HEIGHT.div_ceil(BLOCK);
-/// Cells of a full frame's plane (82 × 62 = 5 084).
-pub const PLANE_CELLS: usize = PLANE_WIDTH * PLANE_HEIGHT;
 
 /// A rectangle of a frame in pixels: columns `x0..x0 + w`, rows `y0..y0 + h`.
 ///

@@ -99,11 +99,17 @@ macro_rules! detector_registry {
             }
 
             /// Bytes of scratch memory the method needs beyond the input frame (its
-            /// `Scratch`), on this target.
+            /// `Scratch`) at the reference capacity (328×248), on this target.
             pub const fn scratch_bytes(self) -> usize {
+                self.scratch_bytes_for::<$crate::capacity::Reference>()
+            }
+
+            /// Bytes of scratch memory the method needs at capacity `C`, on this
+            /// target.
+            pub const fn scratch_bytes_for<C: $crate::capacity::FrameCapacity>(self) -> usize {
                 match self {
                     $($Method::$Variant => ::core::mem::size_of::<
-                        $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work>,
+                        $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work<C>, C>,
                     >(),)+
                 }
             }
@@ -180,22 +186,34 @@ macro_rules! detector_registry {
         }
 
         $(#[$bank_meta])*
-        #[derive(Clone)]
-        $bank_vis struct $Bank {
+        $bank_vis struct $Bank<C: $crate::capacity::FrameCapacity = $crate::capacity::Reference> {
             $(
-                $field: $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work>,
+                $field: $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work<C>, C>,
             )+
         }
 
         impl $Bank {
-            /// Fresh scratch for every detector (a `const fn`, so the bank can be a
-            /// `static`).
+            /// Fresh scratch for every detector at the reference capacity, 328×248 (a
+            /// `const fn`, so the bank can be a `static`).
             pub const fn new() -> Self {
+                Self::for_capacity()
+            }
+        }
+
+        impl<C: $crate::capacity::FrameCapacity> ::core::clone::Clone for $Bank<C> {
+            fn clone(&self) -> Self {
+                $Bank {
+                    $($field: ::core::clone::Clone::clone(&self.$field),)+
+                }
+            }
+        }
+
+        impl<C: $crate::capacity::FrameCapacity> $Bank<C> {
+            /// Fresh scratch for every detector at capacity `C` (a `const fn`).
+            pub const fn for_capacity() -> Self {
                 $Bank {
                     $(
-                        $field: $crate::roi::Scratch::from_work(
-                            <$Det as $crate::roi::Detector>::WORK,
-                        ),
+                        $field: $crate::roi::Scratch::for_capacity(),
                     )+
                 }
             }
@@ -203,7 +221,8 @@ macro_rules! detector_registry {
             /// Runs the detector of `params` on `frame` in its scratch.
             ///
             /// # Errors
-            /// `DetectError` when the parameters are out of bounds.
+            /// `DetectError` when the parameters are out of bounds or the frame
+            /// exceeds capacity `C`.
             #[inline]
             pub fn detect(
                 &mut self,
@@ -216,14 +235,14 @@ macro_rules! detector_registry {
             }
         }
 
-        impl $Bank {
+        impl<C: $crate::capacity::FrameCapacity> $Bank<C> {
             /// Runs `method` with its default parameters on `frame` (the parameters are
             /// constants here, so the compiler specialises each detector for them, as
             /// flight code calling it directly would be).
             ///
             /// # Errors
             /// `DetectError` when the default parameters are out of bounds (never for
-            /// the core's detectors, by their tests).
+            /// the core's detectors, by their tests) or the frame exceeds capacity `C`.
             #[inline(always)]
             pub fn detect_default(
                 &mut self,
@@ -240,9 +259,9 @@ macro_rules! detector_registry {
             }
         }
 
-        impl ::core::default::Default for $Bank {
+        impl<C: $crate::capacity::FrameCapacity> ::core::default::Default for $Bank<C> {
             fn default() -> Self {
-                Self::new()
+                Self::for_capacity()
             }
         }
     };

@@ -17,7 +17,8 @@
 //! frame rows.
 
 use super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
+use crate::frame::Frame;
 
 /// Counters of the gradient histogram: [`COARSE_LANES`] interleaved copies of
 /// `COARSE_BINS / COARSE_LANES` coarse bins (a bin spans `2^(bits+3−9)` gradient
@@ -53,32 +54,29 @@ impl Default for Wge {
     }
 }
 
-/// WGE's buffers: the gradient histogram, one gradient row and one mask row.
+/// WGE's buffers at capacity `C`: the gradient histogram, one gradient row and one
+/// mask row. Counts are `u32` (at most the interior pixels, `< W·H`); gradients are at
+/// most `6 · 65 535`; hull rows are `u16` (`H < 65 535`).
 #[derive(Debug, Clone)]
-pub struct WgeWork {
+pub struct WgeWork<C: FrameCapacity = Reference> {
     hist: [u32; COARSE_BINS],
-    gradient: [u32; FRAME_WIDTH],
-    mask: [bool; FRAME_WIDTH],
+    gradient: C::Row<u32>,
+    mask: C::Row<bool>,
 }
 
-/// The WGE detector's scratch memory.
-pub type WgeScratch = Scratch<WgeWork>;
+impl<C: FrameCapacity> ConstInit for WgeWork<C> {
+    const INIT: Self = WgeWork {
+        hist: [0; COARSE_BINS],
+        gradient: ConstInit::INIT,
+        mask: ConstInit::INIT,
+    };
+}
 
-/// Bytes of [`WgeScratch`] (budget: 16 KiB).
+/// The WGE detector's scratch memory at capacity `C` (default 328×248).
+pub type WgeScratch<C = Reference> = Scratch<WgeWork<C>, C>;
+
+/// Bytes of [`WgeScratch`] at 328×248 (budget: 16 KiB).
 pub const SCRATCH_BYTES: usize = core::mem::size_of::<WgeScratch>();
-
-impl WgeScratch {
-    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
-    pub const fn new() -> Self {
-        Scratch::from_work(<Wge as Detector>::WORK)
-    }
-}
-
-impl Default for WgeScratch {
-    fn default() -> Self {
-        Self::new()
-    }
-}
 
 /// Prewitt L1 gradient magnitudes of interior row `y` (1..h−1) into `out[1..w−1]`;
 /// `out[0]` and `out[w−1]` are 0. `rows` are rows y−1, y, y+1; DN above `max_dn`
@@ -158,7 +156,12 @@ impl Wge {
     /// also collects the hull of the pixels above the bin and, per gradient value in
     /// the bin, the hull of its pixels, so that the all-foreground box needs no third
     /// pass (when the threshold stays inside the bin).
-    fn passes(&self, frame: &Frame<'_>, work: &mut WgeWork, want_hull: bool) -> Passes {
+    fn passes<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut WgeWork<C>,
+        want_hull: bool,
+    ) -> Passes {
         let (w, h) = (frame.width(), frame.height());
         let interior = (w.saturating_sub(2) * h.saturating_sub(2)) as u32;
         let none = Passes {
@@ -171,7 +174,7 @@ impl Wge {
         let k = self.drop_count(interior);
         let shift = (frame.bits() + 3).saturating_sub(COARSE_BITS);
         let WgeWork { hist, gradient, .. } = work;
-        let grad = &mut gradient[..w];
+        let grad = &mut gradient.as_mut()[..w];
         hist.fill(0);
         {
             let (even, odd) = hist.split_at_mut(LANE_BINS);
@@ -303,15 +306,15 @@ impl Wge {
     }
 
     /// Streams the mask `g ≥ threshold` (interior only) to `sink`, every row once.
-    fn mask_pass<F: FnMut(usize, &[bool])>(
+    fn mask_pass<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         frame: &Frame<'_>,
-        work: &mut WgeWork,
+        work: &mut WgeWork<C>,
         threshold: u32,
         mut sink: F,
     ) {
         let (w, h) = (frame.width(), frame.height());
         let WgeWork { gradient, mask, .. } = work;
-        let mask = &mut mask[..w];
+        let mask = &mut mask.as_mut()[..w];
         mask.fill(false);
         if w < 3 || h < 3 || threshold == u32::MAX {
             for y in 0..h {
@@ -320,7 +323,7 @@ impl Wge {
             return;
         }
         sink(0, mask);
-        for_each_gradient_row(frame, &mut gradient[..w], |y, g| {
+        for_each_gradient_row(frame, &mut gradient.as_mut()[..w], |y, g| {
             for (m, &v) in mask[1..w - 1].iter_mut().zip(&g[1..w - 1]) {
                 *m = v >= threshold;
             }
@@ -344,13 +347,8 @@ impl core::fmt::Display for Wge {
 }
 
 impl Detector for Wge {
-    type Work = WgeWork;
+    type Work<C: FrameCapacity> = WgeWork<C>;
     const NAME: &'static str = "wge";
-    const WORK: WgeWork = WgeWork {
-        hist: [0; COARSE_BINS],
-        gradient: [0; FRAME_WIDTH],
-        mask: [false; FRAME_WIDTH],
-    };
 
     fn validate(&self) -> Result<(), DetectError> {
         if !(0.0..=1.0).contains(&self.drop_fraction) {
@@ -373,10 +371,10 @@ impl Detector for Wge {
     /// Foreground: interior pixels with Prewitt L1 gradient `≥ threshold`. Threshold:
     /// the exact order statistic (see the module documentation), at least
     /// `min_gradient`; `u32::MAX` when everything is eliminated.
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut WgeWork,
+        work: &mut WgeWork<C>,
         sink: F,
     ) -> u32 {
         let threshold = self.passes(frame, work, false).threshold;
@@ -386,12 +384,13 @@ impl Detector for Wge {
 
     /// As the provided method, but the all-foreground box usually comes out of the
     /// histogram passes (two gradient passes instead of three); the result is the same.
-    fn detect(
+    fn detect<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
-        scratch: &mut Scratch<WgeWork>,
+        scratch: &mut Scratch<WgeWork<C>, C>,
     ) -> Result<Detection, DetectError> {
         self.validate()?;
+        DetectError::check_capacity::<C>(frame)?;
         let Scratch { work, roi } = scratch;
         let all = self.box_rule == BoxRule::AllForeground;
         let passes = self.passes(frame, work, all);

@@ -8,28 +8,30 @@
 use super::SensorError;
 use super::dn::DnMapping;
 use super::noise::NoiseField;
-use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+use crate::capacity::FrameCapacity;
+use crate::frame::MAX_FRAME_SIDE;
 
 /// Converts `signal` (row-major, `width` columns: F(T) in W m⁻² for radiometry mode, q_fc
 /// in W m⁻² for detection mode) to DN in `out` through `mapping`, adding `noise` when
 /// given (skipped when it is silent), quantising with saturation (NaN signal gives 0).
 ///
 /// # Errors
-/// [`SensorError::BadSize`] when `width` is 0 or above 328, `signal` and `out` differ in
-/// length or are not whole rows, there are more than 248 rows, or the noise field's width
-/// differs.
-pub fn expose_frame(
+/// [`SensorError::BadSize`] when `width` is 0 or above [`MAX_FRAME_SIDE`], `signal`
+/// and `out` differ in length or are not whole rows, there are more than
+/// [`MAX_FRAME_SIDE`] rows, or the noise field's width differs. The pass keeps no
+/// buffer, so only the noise field's capacity `C` bounds the width further.
+pub fn expose_frame<C: FrameCapacity>(
     signal: &[f32],
     width: usize,
     mapping: &DnMapping,
-    noise: Option<&mut NoiseField>,
+    noise: Option<&mut NoiseField<C>>,
     out: &mut [u16],
 ) -> Result<(), SensorError> {
-    if width == 0 || width > FRAME_WIDTH {
+    if width == 0 || width > MAX_FRAME_SIDE {
         return Err(SensorError::BadSize {
             name: "width",
             actual: width,
-            expected: FRAME_WIDTH,
+            expected: MAX_FRAME_SIDE,
         });
     }
     if out.len() != signal.len() {
@@ -39,11 +41,11 @@ pub fn expose_frame(
             expected: signal.len(),
         });
     }
-    if signal.len() % width != 0 || signal.len() / width > FRAME_HEIGHT {
+    if signal.len() % width != 0 || signal.len() / width > MAX_FRAME_SIDE {
         return Err(SensorError::BadSize {
             name: "signal",
             actual: signal.len(),
-            expected: width * FRAME_HEIGHT,
+            expected: width * MAX_FRAME_SIDE,
         });
     }
     let gain = mapping.gain_dn() as f32;

@@ -49,7 +49,7 @@
 use super::dn::DnMapping;
 use super::rng::Xoshiro128pp;
 use super::{SensorError, check_positive, check_range};
-use crate::frame::FRAME_WIDTH;
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
 
 /// Boltzmann constant k_B, J K⁻¹ (SI 2019 exact).
 pub const BOLTZMANN_J_K: f64 = 1.380_649e-23;
@@ -345,9 +345,10 @@ impl NoiseSigmas {
     }
 }
 
-/// A seeded noise map in DN, produced one row at a time (module docs). 1 360 bytes.
+/// A seeded noise map in DN, produced one row at a time (module docs), for rows up to
+/// capacity `C`'s width (default the reference 328: 1 360 bytes).
 #[derive(Debug, Clone)]
-pub struct NoiseField {
+pub struct NoiseField<C: FrameCapacity = Reference> {
     rng: Xoshiro128pp,
     white_dn: f32,
     flicker_dn: f32,
@@ -358,12 +359,13 @@ pub struct NoiseField {
     width: usize,
     rows: usize,
     /// The 1/f map's previous row (the vertical filter's state), unit variance.
-    column: [f32; FRAME_WIDTH],
+    column: C::Row<f32>,
 }
 
 impl NoiseField {
-    /// A field of `width` columns (1..=328) with the given σ per source, 1/f correlation
-    /// length `flicker_correlation_px` (≥ 0; 0 makes the 1/f map white), and `seed`.
+    /// A field of `width` columns (1..=328, the reference capacity) with the given σ
+    /// per source, 1/f correlation length `flicker_correlation_px` (≥ 0; 0 makes the
+    /// 1/f map white), and `seed`.
     ///
     /// # Errors
     /// [`SensorError`] for a width outside 1..=328, or σ or ℓ not finite and ≥ 0.
@@ -373,11 +375,27 @@ impl NoiseField {
         width: usize,
         seed: u64,
     ) -> Result<Self, SensorError> {
-        if width == 0 || width > FRAME_WIDTH {
+        Self::for_capacity(sigmas, flicker_correlation_px, width, seed)
+    }
+}
+
+impl<C: FrameCapacity> NoiseField<C> {
+    /// As [`NoiseField::new`], for rows up to capacity `C`'s width (the same noise: the
+    /// capacity only sizes the filter's row of state).
+    ///
+    /// # Errors
+    /// [`SensorError`] for a width outside 1..=`C::WIDTH`, or σ or ℓ not finite and ≥ 0.
+    pub fn for_capacity(
+        sigmas: NoiseSigmas,
+        flicker_correlation_px: f32,
+        width: usize,
+        seed: u64,
+    ) -> Result<Self, SensorError> {
+        if width == 0 || width > C::WIDTH {
             return Err(SensorError::BadSize {
                 name: "width",
                 actual: width,
-                expected: FRAME_WIDTH,
+                expected: C::WIDTH,
             });
         }
         for (name, v) in [
@@ -401,7 +419,7 @@ impl NoiseField {
             innovation: libm::sqrtf(1.0 - alpha * alpha),
             width,
             rows: 0,
-            column: [0.0; FRAME_WIDTH],
+            column: ConstInit::INIT,
         })
     }
 
@@ -417,7 +435,7 @@ impl NoiseField {
 
     /// The next row of noise, `width` values in DN, left to right. Consume each row to
     /// its end before asking for the next (the 1/f filter's state advances per pixel).
-    pub fn next_row(&mut self) -> NoiseRow<'_> {
+    pub fn next_row(&mut self) -> NoiseRow<'_, C> {
         let first = self.rows == 0;
         self.rows += 1;
         // Stationary start of the horizontal filter: h₋₁ ~ N(0, 1).
@@ -433,14 +451,14 @@ impl NoiseField {
 
 /// One row of a [`NoiseField`]: an iterator of `width` noise values in DN.
 #[derive(Debug)]
-pub struct NoiseRow<'a> {
-    field: &'a mut NoiseField,
+pub struct NoiseRow<'a, C: FrameCapacity = Reference> {
+    field: &'a mut NoiseField<C>,
     x: usize,
     h: f32,
     first: bool,
 }
 
-impl Iterator for NoiseRow<'_> {
+impl<C: FrameCapacity> Iterator for NoiseRow<'_, C> {
     type Item = f32;
 
     fn next(&mut self) -> Option<f32> {
@@ -456,9 +474,9 @@ impl Iterator for NoiseRow<'_> {
         let z = if self.first {
             self.h
         } else {
-            f.alpha * f.column[x] + f.innovation * self.h
+            f.alpha * f.column.as_ref()[x] + f.innovation * self.h
         };
-        f.column[x] = z;
+        f.column.as_mut()[x] = z;
         Some(f.white_dn * white + f.flicker_dn * z)
     }
 
@@ -468,4 +486,4 @@ impl Iterator for NoiseRow<'_> {
     }
 }
 
-impl ExactSizeIterator for NoiseRow<'_> {}
+impl<C: FrameCapacity> ExactSizeIterator for NoiseRow<'_, C> {}

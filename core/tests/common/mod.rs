@@ -19,6 +19,7 @@ use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
 use tirroi_core::sensor::rng::Xoshiro128pp;
 use tirroi_core::{BoxRule, DetectError, Detection, Detector, Frame, Roi};
+use tirroi_core::{FrameCapacity, Reference};
 
 // ---------------------------------------------------------------------------------
 // Seeded generator
@@ -521,9 +522,17 @@ pub fn otsu_exhaustive(pixels: &[u16], bits: u8) -> Option<u32> {
         let den = u128::from(n0) * u128::from(n - n0);
         let better = match best {
             None => true,
-            Some((_, bd2, bden)) => {
-                d2.checked_mul(bden).expect("bound") > bd2.checked_mul(den).expect("bound")
-            }
+            Some((_, bd2, bden)) => match (d2.checked_mul(bden), bd2.checked_mul(den)) {
+                (Some(a), Some(b)) => a > b,
+                // Frames above the reference size: quotients, then remainders
+                // cross-multiplied (each below its denominator ≤ N²/4 < 2^38 for
+                // N ≤ 1024·768, so products < 2^76).
+                _ => {
+                    let (q1, r1) = (d2 / den, d2 % den);
+                    let (q2, r2) = (bd2 / bden, bd2 % bden);
+                    q1 > q2 || (q1 == q2 && r1 * bden > r2 * den)
+                }
+            },
         };
         if better {
             best = Some((t as u32, d2, den));
@@ -743,13 +752,13 @@ pub fn box_by_rule(rule: BoxRule, mask: &[bool], w: usize, h: usize) -> Option<R
 /// Detectors whose scratch the tests can build.
 pub trait TestDetector: Detector + Copy {
     /// Fresh scratch memory, boxed (DoG's is 70 KiB).
-    fn scratch() -> Box<Scratch<Self::Work>>;
+    fn scratch() -> Box<Scratch<Self::Work<Reference>>>;
     /// The same detector with another box rule.
     fn with_rule(self, rule: BoxRule) -> Self;
 }
 
 impl TestDetector for Otsu {
-    fn scratch() -> Box<Scratch<Self::Work>> {
+    fn scratch() -> Box<Scratch<Self::Work<Reference>>> {
         Box::new(OtsuScratch::new())
     }
     fn with_rule(self, box_rule: BoxRule) -> Self {
@@ -758,7 +767,7 @@ impl TestDetector for Otsu {
 }
 
 impl TestDetector for Adaptive {
-    fn scratch() -> Box<Scratch<Self::Work>> {
+    fn scratch() -> Box<Scratch<Self::Work<Reference>>> {
         Box::new(AdaptiveScratch::new())
     }
     fn with_rule(self, box_rule: BoxRule) -> Self {
@@ -767,7 +776,7 @@ impl TestDetector for Adaptive {
 }
 
 impl TestDetector for Wge {
-    fn scratch() -> Box<Scratch<Self::Work>> {
+    fn scratch() -> Box<Scratch<Self::Work<Reference>>> {
         Box::new(WgeScratch::new())
     }
     fn with_rule(self, box_rule: BoxRule) -> Self {
@@ -776,7 +785,7 @@ impl TestDetector for Wge {
 }
 
 impl TestDetector for Dog {
-    fn scratch() -> Box<Scratch<Self::Work>> {
+    fn scratch() -> Box<Scratch<Self::Work<Reference>>> {
         Box::new(DogScratch::new())
     }
     fn with_rule(self, box_rule: BoxRule) -> Self {
@@ -793,9 +802,8 @@ pub struct Spy<D> {
 }
 
 impl<D: Detector> Detector for Spy<D> {
-    type Work = D::Work;
+    type Work<C: FrameCapacity> = D::Work<C>;
     const NAME: &'static str = "spy";
-    const WORK: D::Work = D::WORK;
 
     fn validate(&self) -> Result<(), DetectError> {
         self.inner.validate()
@@ -805,10 +813,10 @@ impl<D: Detector> Detector for Spy<D> {
         self.inner.box_rule()
     }
 
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut Self::Work,
+        work: &mut Self::Work<C>,
         mut sink: F,
     ) -> u32 {
         self.inner.foreground(frame, work, |y, mask| {
@@ -831,7 +839,11 @@ pub struct Observed {
 /// row protocol of [`Detector::foreground`] (rows 0..h in order, each exactly once,
 /// each `w` long) and that `foreground_px` counts the mask.
 #[track_caller]
-pub fn observe_in<D: Detector>(det: D, img: &Img, scratch: &mut Scratch<D::Work>) -> Observed {
+pub fn observe_in<D: Detector, C: FrameCapacity>(
+    det: D,
+    img: &Img,
+    scratch: &mut Scratch<D::Work<C>, C>,
+) -> Observed {
     let spy = Spy {
         inner: det,
         rows: RefCell::new(Vec::new()),

@@ -2,16 +2,25 @@
 
 use std::time::Instant;
 
+use tirroi_core::capacity::{Cap640x512, Cap1024x768};
 use tirroi_core::roi::{Detectors, Params};
-use tirroi_core::{BoxRule, DetectError, Detection, Frame, Method, Roi};
+use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method, Roi};
 
 /// Every registered detector (the core's registry, [`Method::ALL`]) with its
-/// parameters and its scratch memory (boxed: about 141 KB), ready to run frame after
-/// frame.
+/// parameters and its scratch memory, ready to run frame after frame: the 328×248
+/// bank (boxed: about 141 KB) and, made on the first frame that needs them, the
+/// 640×512 and 1024×768 banks; the smallest that holds a frame runs it.
 pub struct DetectorBank {
     /// The parameters of each method, at [`Method::index`].
     params: [Params; Method::ALL.len()],
     scratch: Box<Detectors>,
+    scratch_640x512: Option<Box<Detectors<Cap640x512>>>,
+    scratch_1024x768: Option<Box<Detectors<Cap1024x768>>>,
+}
+
+/// True when `frame` fits capacity `C`.
+fn fits<C: FrameCapacity>(frame: &Frame<'_>) -> bool {
+    frame.width() <= C::WIDTH && frame.height() <= C::HEIGHT
 }
 
 impl Default for DetectorBank {
@@ -20,6 +29,8 @@ impl Default for DetectorBank {
         DetectorBank {
             params: Method::ALL.map(Method::default_params),
             scratch: Box::new(Detectors::new()),
+            scratch_640x512: None,
+            scratch_1024x768: None,
         }
     }
 }
@@ -53,9 +64,22 @@ impl DetectorBank {
     /// Runs `method` on `frame`.
     ///
     /// # Errors
-    /// The core's [`DetectError`] for parameters out of bounds.
+    /// The core's [`DetectError`] for parameters out of bounds or a frame above the
+    /// largest capacity (1024×768).
     pub fn detect(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        self.scratch.detect(&self.params[method.index()], frame)
+        let params = &self.params[method.index()];
+        if fits::<tirroi_core::Reference>(frame) {
+            self.scratch.detect(params, frame)
+        } else if fits::<Cap640x512>(frame) {
+            self.scratch_640x512
+                .get_or_insert_with(Box::default)
+                .detect(params, frame)
+        } else {
+            // Above 1024×768 the core answers `DetectError::FrameTooLarge`.
+            self.scratch_1024x768
+                .get_or_insert_with(Box::default)
+                .detect(params, frame)
+        }
     }
 
     /// Runs `method` `repeat` times (at least once) and returns the detection with the

@@ -4,7 +4,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use image::{DynamicImage, ImageReader};
-use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+use tirroi_core::capacity::{Cap1024x768, FrameCapacity};
 use tirroi_core::{Frame, FrameError};
 
 /// A frame read from a file: owned DN and the bit depth they are read at.
@@ -55,7 +55,7 @@ impl std::error::Error for FrameFileError {}
 ///
 /// # Errors
 /// A [`FrameFileError`] naming the file when it cannot be opened or decoded, is a colour
-/// image, or is larger than the 328×248 frames the core holds.
+/// image, or is larger than the largest capacity of the core's detectors (1024×768).
 pub fn read_frame(path: &Path, bits: Option<u8>) -> Result<FrameBuf, FrameFileError> {
     let fail = |problem: String| FrameFileError {
         path: path.to_path_buf(),
@@ -84,9 +84,10 @@ pub fn read_frame(path: &Path, bits: Option<u8>) -> Result<FrameBuf, FrameFileEr
             )));
         }
     };
-    if width > FRAME_WIDTH || height > FRAME_HEIGHT {
+    let (max_w, max_h) = (Cap1024x768::WIDTH, Cap1024x768::HEIGHT);
+    if width > max_w || height > max_h {
         return Err(fail(format!(
-            "image is {width}x{height} px; the core takes frames of at most {FRAME_WIDTH}x{FRAME_HEIGHT} px"
+            "image is {width}x{height} px; the core takes frames of at most {max_w}x{max_h} px"
         )));
     }
     let bits = match bits {

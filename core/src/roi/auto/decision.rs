@@ -14,12 +14,11 @@ pub(super) fn choose_target(
 ) -> Option<(u8, CellStats)> {
     // The Earth's limb (an arc from border to border) and Earth patches cut by the
     // frame lose to a compact outline inside it.
-    let (pw8, ph8) = (pw as u8, ph as u8);
     let sides = |c: &CellStats| {
         u32::from(c.x0 == 0)
             + u32::from(c.y0 == 0)
-            + u32::from(c.x1 >= pw8)
-            + u32::from(c.y1 >= ph8)
+            + u32::from(c.x_end() >= pw)
+            + u32::from(c.y_end() >= ph)
     };
     let parent = comps.parents();
     let shift = u32::from(side_shift);

@@ -10,18 +10,21 @@ use super::steps::step_value;
 /// Most edge components labelled per frame (labels 1..=250 of a `u8` plane); edge
 /// cells that would start a further component are dropped (a frame that noisy has no
 /// outline worth boxing; it is labelled again with a higher threshold). Unlike the
-/// mask's table (components open at once, reused), this is a whole frame's count.
+/// mask's table (components open at once, reused), this is a whole frame's count; it
+/// does not grow with the capacity (a larger frame of that many components is as
+/// noisy, and is labelled again the same way).
 pub const MAX_EDGE_COMPONENTS: usize = 250;
 
 /// Statistics of one component of edge cells (`auto`'s use of the shared labelling).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct CellStats {
-    /// Cell box, exclusive ends.
+    /// Cell box, inclusive ends (the last cell, so `u8` holds planes of up to 256
+    /// cells a side: 1024 pixels; every capacity meets it, [`crate::capacity`]).
     pub x0: u8,
     pub y0: u8,
-    pub x1: u8,
-    pub y1: u8,
-    /// Edge cells.
+    pub x_last: u8,
+    pub y_last: u8,
+    /// Edge cells (saturating: 49 152 cells at 1024×768 fit).
     pub area: u16,
     /// Sum of the cells' coarse gradients.
     pub energy: u32,
@@ -29,12 +32,26 @@ pub(super) struct CellStats {
     pub gmax: u32,
 }
 
+impl crate::capacity::ConstInit for CellStats {
+    const INIT: Self = NO_CELLS;
+}
+
 impl CellStats {
+    /// One past the last cell column.
+    pub fn x_end(&self) -> usize {
+        usize::from(self.x_last) + 1
+    }
+
+    /// One past the last cell row.
+    pub fn y_end(&self) -> usize {
+        usize::from(self.y_last) + 1
+    }
+
     fn add(&mut self, x: u8, y: u8, q: u32) {
         self.x0 = self.x0.min(x);
         self.y0 = self.y0.min(y);
-        self.x1 = self.x1.max(x.saturating_add(1));
-        self.y1 = self.y1.max(y.saturating_add(1));
+        self.x_last = self.x_last.max(x);
+        self.y_last = self.y_last.max(y);
         self.area = self.area.saturating_add(1);
         self.energy = self.energy.saturating_add(q);
         self.gmax = self.gmax.max(q);
@@ -45,8 +62,8 @@ impl Stats for CellStats {
     fn merge(&mut self, o: &CellStats) {
         self.x0 = self.x0.min(o.x0);
         self.y0 = self.y0.min(o.y0);
-        self.x1 = self.x1.max(o.x1);
-        self.y1 = self.y1.max(o.y1);
+        self.x_last = self.x_last.max(o.x_last);
+        self.y_last = self.y_last.max(o.y_last);
         self.area = self.area.saturating_add(o.area);
         self.energy = self.energy.saturating_add(o.energy);
         self.gmax = self.gmax.max(o.gmax);
@@ -56,8 +73,8 @@ impl Stats for CellStats {
 pub(super) const NO_CELLS: CellStats = CellStats {
     x0: u8::MAX,
     y0: u8::MAX,
-    x1: 0,
-    y1: 0,
+    x_last: 0,
+    y_last: 0,
     area: 0,
     energy: 0,
     gmax: 0,
@@ -65,7 +82,8 @@ pub(super) const NO_CELLS: CellStats = CellStats {
 
 /// The edge components of a frame: `u8` labels (0: not an edge cell); the parent table
 /// spans all 256 `u8` values (no bounds checks), statistics only the labels handed out.
-pub(super) type EdgeComponents = Components<u8, CellStats, 256, { MAX_EDGE_COMPONENTS + 1 }>;
+pub(super) type EdgeComponents =
+    Components<u8, CellStats, [u8; 256], [CellStats; MAX_EDGE_COMPONENTS + 1]>;
 
 /// Labels the edge cells of `step` (the step codes, `pw` per row) into `labels`,
 /// first at `threshold`, then, while some edge cell finds no free label, at a

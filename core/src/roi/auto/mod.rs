@@ -72,11 +72,12 @@ mod tracking;
 
 pub use edges::MAX_EDGE_COMPONENTS;
 
-use super::plane::{BLOCK, PLANE_CELLS, Window};
+use super::plane::{BLOCK, Window};
 use super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
-use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
+use crate::frame::{FRAME_WIDTH, Frame};
 use decision::choose_target;
-use edges::{EdgeComponents, NO_CELLS, label_edge_cells};
+use edges::{EdgeComponents, label_edge_cells};
 use noise::{NOISE_BINS, noise_sigma};
 use refine::{Region, build_gate, count_saturation, outline};
 use rules::{MIN_SATURATED_PX, STEP_UNITS_PER_SIGMA};
@@ -148,50 +149,54 @@ impl Auto {
 
 /// `auto`'s buffers. Two cell planes and two rows change meaning between stages; the
 /// field docs say what each holds when, and the stages take them under the role names.
+///
+/// At capacity `C` (`W × H` pixels, `PW × PH` cells): saturation counts per row and
+/// column are at most `W`, `H` ≤ 1024 (`u16`); cell coordinates are `u8` (inclusive,
+/// ≤ 255 cells); labels `u8` ([`MAX_EDGE_COMPONENTS`], independent of the capacity).
 #[derive(Debug, Clone)]
-pub struct AutoWork {
+pub struct AutoWork<C: FrameCapacity = Reference> {
     /// Cell plane (window cells, row-major): the step codes (stage 2, read by stage 3);
     /// then, free, the winner dilated along rows (`row_dilated`, building the gate).
-    step_codes: [u8; PLANE_CELLS],
+    step_codes: C::Cells<u8>,
     /// Cell plane: the component labels (stage 3; 0: not an edge cell); then the gate
     /// (stage 5: the winner's cells and their neighbours, a `refine::Gate`).
-    labels: [u8; PLANE_CELLS],
+    labels: C::Cells<u8>,
     /// The edge components (the shared union-find): parents of all 256 `u8` labels,
     /// statistics of the labels handed out.
     comps: EdgeComponents,
     /// One pixel row: the clamped noise row (stage 1), then the largest steps per pixel
     /// of one band of rows (`band`, stage 2).
-    pixel_row: [u16; FRAME_WIDTH],
+    pixel_row: C::Row<u16>,
     /// Saturated pixels per column and per row of the refinement window.
-    col_sat: [u16; FRAME_WIDTH],
-    row_sat: [u16; FRAME_HEIGHT],
+    col_sat: C::Row<u16>,
+    row_sat: C::Column<u16>,
     /// Histogram of one noise estimate.
     hist: [u32; NOISE_BINS + 1],
     /// One row of flags: the winner's cells of one cell row, padded by a cell on each
     /// side (`winner_row`, building the gate), or a mask row of
     /// [`Detector::foreground`] (`mask_row`).
-    flag_row: [bool; FRAME_WIDTH],
+    flag_row: C::Row<bool>,
 }
 
-/// The `auto` detector's scratch memory.
-pub type AutoScratch = Scratch<AutoWork>;
+impl<C: FrameCapacity> ConstInit for AutoWork<C> {
+    const INIT: Self = AutoWork {
+        step_codes: ConstInit::INIT,
+        labels: ConstInit::INIT,
+        comps: ConstInit::INIT,
+        pixel_row: ConstInit::INIT,
+        col_sat: ConstInit::INIT,
+        row_sat: ConstInit::INIT,
+        hist: [0; NOISE_BINS + 1],
+        flag_row: ConstInit::INIT,
+    };
+}
 
-/// Bytes of [`AutoScratch`] (budget: 32 KiB, checked at compile time).
+/// The `auto` detector's scratch memory at capacity `C` (default 328×248).
+pub type AutoScratch<C = Reference> = Scratch<AutoWork<C>, C>;
+
+/// Bytes of [`AutoScratch`] at 328×248 (budget: 32 KiB, checked at compile time).
 pub const SCRATCH_BYTES: usize = core::mem::size_of::<AutoScratch>();
 const _: () = assert!(SCRATCH_BYTES <= 32 * 1024, "auto's scratch exceeds 32 KiB");
-
-impl AutoScratch {
-    /// Fresh scratch memory (a `const fn`, so it can be a `static`).
-    pub const fn new() -> Self {
-        Scratch::from_work(<Auto as Detector>::WORK)
-    }
-}
-
-impl Default for AutoScratch {
-    fn default() -> Self {
-        Self::new()
-    }
-}
 
 /// What one pass of the pipeline found in a window.
 #[derive(Debug, Clone, Copy)]
@@ -205,7 +210,12 @@ struct Found {
 
 impl Auto {
     /// Runs the pipeline's stages on `win`; `None` when no component is found.
-    fn locate(&self, frame: &Frame<'_>, work: &mut AutoWork, win: Window) -> Option<Found> {
+    fn locate<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoWork<C>,
+        win: Window,
+    ) -> Option<Found> {
         let AutoWork {
             step_codes,
             labels,
@@ -218,9 +228,10 @@ impl Auto {
         } = work;
         let plane = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
         let (step_codes, labels) = (
-            &mut step_codes[..plane.0 * plane.1],
-            &mut labels[..plane.0 * plane.1],
+            &mut step_codes.as_mut()[..plane.0 * plane.1],
+            &mut labels.as_mut()[..plane.0 * plane.1],
         );
+        let (pixel_row, flag_row) = (pixel_row.as_mut(), flag_row.as_mut());
         // 1. Noise and scene.
         let noise = noise_sigma(frame, win, hist, pixel_row);
         // 2. Step plane (codes below the edge threshold's are not worked out).
@@ -260,13 +271,13 @@ impl Auto {
             win,
             plane,
         );
-        let counts = count_saturation(
+        let counts = count_saturation::<C>(
             frame,
             &gate,
             &region,
             self.near_saturation(frame, noise.sigma),
-            &mut col_sat[region.rx0..region.rx1],
-            &mut row_sat[region.ry0..region.ry1],
+            &mut col_sat.as_mut()[region.rx0..region.rx1],
+            &mut row_sat.as_mut()[region.ry0..region.ry1],
         );
         // 6. Saturated target, then the outermost boundaries.
         let saturated = self.is_saturated(counts.sat_px, counts.near_px);
@@ -327,18 +338,8 @@ impl core::fmt::Display for Auto {
 }
 
 impl Detector for Auto {
-    type Work = AutoWork;
+    type Work<C: FrameCapacity> = AutoWork<C>;
     const NAME: &'static str = "auto";
-    const WORK: AutoWork = AutoWork {
-        step_codes: [0; PLANE_CELLS],
-        labels: [0; PLANE_CELLS],
-        comps: EdgeComponents::new(0, NO_CELLS),
-        pixel_row: [0; FRAME_WIDTH],
-        col_sat: [0; FRAME_WIDTH],
-        row_sat: [0; FRAME_HEIGHT],
-        hist: [0; NOISE_BINS + 1],
-        flag_row: [false; FRAME_WIDTH],
-    };
 
     fn validate(&self) -> Result<(), DetectError> {
         let checks: [(bool, &'static str, &'static str); 8] = [
@@ -396,15 +397,15 @@ impl Detector for Auto {
 
     /// Foreground: the detected box, filled. Threshold: the coarse edge threshold
     /// (`coarse_sigma · σ`, DN).
-    fn foreground<F: FnMut(usize, &[bool])>(
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
         &self,
         frame: &Frame<'_>,
-        work: &mut AutoWork,
+        work: &mut AutoWork<C>,
         mut sink: F,
     ) -> u32 {
         let d = self.run(frame, work);
         let roi = d.roi.unwrap_or(Roi::EMPTY);
-        let mask_row = &mut work.flag_row[..frame.width()];
+        let mask_row = &mut work.flag_row.as_mut()[..frame.width()];
         for y in 0..frame.height() {
             mask_row.fill(false);
             if roi.contains(roi.x0, y as u16) {
@@ -417,12 +418,13 @@ impl Detector for Auto {
 
     /// Runs `auto` (without the mask pass of the default: the box comes straight from
     /// the refinement). `foreground_px` counts the edge pixels that made the box.
-    fn detect(
+    fn detect<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
-        scratch: &mut Scratch<AutoWork>,
+        scratch: &mut Scratch<AutoWork<C>, C>,
     ) -> Result<Detection, DetectError> {
         self.validate()?;
+        DetectError::check_capacity::<C>(frame)?;
         Ok(self.run(frame, &mut scratch.work))
     }
 }
@@ -493,6 +495,7 @@ mod tests {
             match a.validate() {
                 Err(super::DetectError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
                 Ok(()) => panic!("{name} accepted"),
+                Err(e) => panic!("{name}: {e}"),
             }
         }
     }

@@ -6,7 +6,7 @@ use super::rules::{
     CLEAN_ZERO_PER_MIXED, FIRST_DIFF_SIGMA, MIN_NOISE_SAMPLES, NOISE_ROWS, SECOND_DIFF_SIGMA,
     SPACE_ZERO_SHARE,
 };
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::frame::Frame;
 
 /// Bins of the noise histogram (16 exact bins, then 4 per octave up to 2^16).
 pub(super) const NOISE_BINS: usize = 64;
@@ -67,7 +67,7 @@ fn hist_median(hist: &[u32]) -> Option<u32> {
 fn for_each_noise_sample(
     frame: &Frame<'_>,
     win: Window,
-    buf: &mut [u16; FRAME_WIDTH],
+    buf: &mut [u16],
     mut f: impl FnMut(u16, u16, u16),
 ) {
     let max_dn = frame.max_dn();
@@ -92,7 +92,7 @@ fn difference_sigma<const SECOND: bool>(
     frame: &Frame<'_>,
     win: Window,
     hist: &mut [u32; NOISE_BINS + 1],
-    buf: &mut [u16; FRAME_WIDTH],
+    buf: &mut [u16],
 ) -> Option<u32> {
     let max_dn = frame.max_dn();
     hist.fill(0);
@@ -131,7 +131,7 @@ pub(super) fn noise_sigma(
     frame: &Frame<'_>,
     win: Window,
     hist: &mut [u32; NOISE_BINS + 1],
-    buf: &mut [u16; FRAME_WIDTH],
+    buf: &mut [u16],
 ) -> Noise {
     let (mut pairs, mut zero_pairs, mut one_zero) = (0u32, 0u32, 0u32);
     for_each_noise_sample(frame, win, buf, |a, b, _| {

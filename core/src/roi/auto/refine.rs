@@ -3,10 +3,11 @@
 //! target's box.
 
 use super::super::Roi;
-use super::super::plane::{BLOCK, PLANE_WIDTH, Window};
+use super::super::plane::{BLOCK, Window};
 use super::edges::{CellStats, EdgeComponents};
 use super::noise::Noise;
 use super::rules::{GATE_CELLS, SATURATED_TAU_FACTOR, TRIM_LINE_PX, TRIM_PASSES};
+use crate::capacity::{ConstInit, FrameCapacity};
 use crate::frame::Frame;
 
 /// The refinement window: the winner's cell box grown by [`GATE_CELLS`], in frame
@@ -29,8 +30,9 @@ impl Region {
         let cell_px = |cell: u8| usize::from(cell) * BLOCK;
         let rx0 = win.x0 + cell_px(c.x0.saturating_sub(GATE_CELLS));
         let ry0 = win.y0 + cell_px(c.y0.saturating_sub(GATE_CELLS));
-        let rx1 = (win.x0 + cell_px(c.x1.saturating_add(GATE_CELLS))).min(win.x0 + win.w);
-        let ry1 = (win.y0 + cell_px(c.y1.saturating_add(GATE_CELLS))).min(win.y0 + win.h);
+        let end_px = |end: usize| (end + usize::from(GATE_CELLS)) * BLOCK;
+        let rx1 = (win.x0 + end_px(c.x_end())).min(win.x0 + win.w);
+        let ry1 = (win.y0 + end_px(c.y_end())).min(win.y0 + win.h);
         let (ca, cb) = ((rx0 - win.x0) / BLOCK, (rx1 - 1 - win.x0) / BLOCK + 1);
         let (ra, rb) = ((ry0 - win.y0) / BLOCK, (ry1 - 1 - win.y0) / BLOCK + 1);
         Region {
@@ -144,7 +146,7 @@ pub(super) struct SaturationCounts<'a> {
 
 /// Counts saturated pixels (and pixels at `near_sat` DN or above) over the gated
 /// cells of the region, into `col_sat` and `row_sat` (region-sized slices).
-pub(super) fn count_saturation<'a>(
+pub(super) fn count_saturation<'a, C: FrameCapacity>(
     frame: &Frame<'_>,
     gate: &Gate<'_>,
     region: &Region,
@@ -169,7 +171,8 @@ pub(super) fn count_saturation<'a>(
     row_sat.fill(0);
     // Runs of gated cells of a cell row as pixel ranges relative to rx0 (set for
     // each cell row): the counts touch gated pixels only, a slice per run.
-    let mut runs = [(0u16, 0u16); PLANE_WIDTH / 2 + 1];
+    let mut runs = <C::CellRuns<(u16, u16)> as ConstInit>::INIT;
+    let runs = runs.as_mut();
     let (mut n_runs, mut runs_row) = (0, usize::MAX);
     for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
         let Some(row) = frame.row(y) else { continue };

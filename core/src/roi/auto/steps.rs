@@ -3,7 +3,7 @@
 
 use super::super::plane::{BLOCK, Window};
 use super::rules::{STEP_CODE_FRACTION_BITS, STEP_CODES_PER_OCTAVE, STEP_UNITS_PER_SIGMA};
-use crate::frame::{FRAME_WIDTH, Frame};
+use crate::frame::Frame;
 
 /// The step plane of `win` into `plane` (`pw` cells per row): per cell, the largest
 /// absolute difference of a pixel and the pixel two to its right or two below, on
@@ -18,7 +18,7 @@ pub(super) fn step_plane(
     sigma: u32,
     floor: u32,
     pw: usize,
-    band: &mut [u16; FRAME_WIDTH],
+    band: &mut [u16],
     plane: &mut [u8],
 ) {
     let max_dn = frame.max_dn();

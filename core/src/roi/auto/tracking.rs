@@ -6,11 +6,16 @@
 use super::super::Detection;
 use super::super::plane::Window;
 use super::{Auto, AutoWork, Found};
+use crate::capacity::FrameCapacity;
 use crate::frame::Frame;
 
 impl Auto {
     /// The detection (box, coarse threshold, edge pixels), tracking window first.
-    pub(super) fn run(&self, frame: &Frame<'_>, work: &mut AutoWork) -> Detection {
+    pub(super) fn run<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoWork<C>,
+    ) -> Detection {
         let full = Window::full(frame);
         if let Some(p) = self.prior {
             let p = p.clip(frame.width() as u16, frame.height() as u16);

@@ -32,6 +32,7 @@
 use std::time::Instant;
 
 use tirroi_core::Roi;
+use tirroi_core::capacity::Cap1024x768;
 use tirroi_core::sensor::noise::NoiseRms;
 use tirroi_core::sensor::{
     BandLut, BandRadiance, DetectionScale, DnMapping, NoiseField, NoiseLevel, SENSOR_AREA_M2,
@@ -315,7 +316,9 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
             };
             let sigmas = level.sigmas(&NoiseRms::TABLE2, &mapping)?;
             noise_sigma_dn = sigmas.total_dn();
-            Some(NoiseField::new(
+            // The largest capacity: the same noise at any size (the capacity only
+            // sizes the filter's row of state).
+            Some(NoiseField::<Cap1024x768>::for_capacity(
                 sigmas,
                 input.camera.flicker_correlation_px,
                 cam.w,

@@ -1,6 +1,7 @@
 //! The camera of a scene (Table 4, Hayabusa2 TIR) and its read-out.
 
 use serde::{Deserialize, Serialize};
+use tirroi_core::capacity::{Cap1024x768, FrameCapacity};
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
 
@@ -12,9 +13,10 @@ pub struct Camera {
     pub focal_length_mm: f64,
     /// Pixel pitch, µm (Table 4: 37).
     pub pixel_pitch_um: f64,
-    /// Columns, 1..=328 (Table 4: 328).
+    /// Columns, 1..=1024 (Table 4: 328; up to the core's largest capacity, 1024×768,
+    /// at the same pixel pitch and IFOV: a larger array sees a wider field).
     pub width: usize,
-    /// Rows, 1..=248 (Table 4: 248).
+    /// Rows, 1..=768 (Table 4: 248).
     pub height: usize,
     /// Bits per DN, 1..=16 (default 14).
     pub bits: u8,
@@ -83,9 +85,10 @@ impl Camera {
                 self.flicker_correlation_px
             ));
         }
-        if !(1..=FRAME_WIDTH).contains(&self.width) || !(1..=FRAME_HEIGHT).contains(&self.height) {
+        let (max_w, max_h) = (Cap1024x768::WIDTH, Cap1024x768::HEIGHT);
+        if !(1..=max_w).contains(&self.width) || !(1..=max_h).contains(&self.height) {
             return Err(format!(
-                "camera.width × height = {} × {}: expected at most {FRAME_WIDTH} × {FRAME_HEIGHT} (the core's frame)",
+                "camera.width × height = {} × {}: expected at most {max_w} × {max_h} (the core's largest capacity)",
                 self.width, self.height
             ));
         }

@@ -53,7 +53,15 @@ fn errors_name_line_and_field() {
     .unwrap_err();
     assert!(e.to_string().contains("multiple of the 2 scales"), "{e}");
     let e =
-        SceneFile::parse("[camera]\nwidth = 640\n[[scene]]\nrange_m = 20.0\n", "x").unwrap_err();
+        SceneFile::parse("[camera]\nwidth = 1025\n[[scene]]\nrange_m = 20.0\n", "x").unwrap_err();
     assert!(e.to_string().contains("camera.width"), "{e}");
+    // Up to the core's largest capacity.
+    assert!(
+        SceneFile::parse(
+            "[camera]\nwidth = 1024\nheight = 768\n[[scene]]\nrange_m = 20.0\n",
+            "x"
+        )
+        .is_ok()
+    );
     assert!(SceneFile::parse("", "x").is_err());
 }
