@@ -223,8 +223,9 @@ fn blur_rows_transposed(src: &[u16], dst: &mut [u16], w: usize, kernel: &[i16], 
             *m = centred(v);
         }
         right.fill(centred(row[w - 1]));
-        for x in 0..w {
-            let window = &pad[x..x + taps];
+        // Output column y of the transposed destination: element x at x·h + y.
+        let column = dst.get_mut(y..).unwrap_or_default().iter_mut().step_by(h);
+        for (out, window) in column.zip(pad.windows(taps)).take(w) {
             let mut acc = 0i32;
             for (kc, vc) in weights.chunks_exact(LANES).zip(window.chunks_exact(LANES)) {
                 for (&k, &v) in kc.iter().zip(vc) {
@@ -232,7 +233,7 @@ fn blur_rows_transposed(src: &[u16], dst: &mut [u16], w: usize, kernel: &[i16], 
                 }
             }
             let acc = (acc + (1 << 30)) as u32;
-            dst[x * h + y] = ((acc + ONE_Q15 / 2) >> 15) as u16;
+            *out = ((acc + ONE_Q15 / 2) >> 15) as u16;
         }
     }
 }
@@ -470,10 +471,17 @@ fn find_blobs<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, pw: usize, ph:
             neighbours[layers] = planes(i + 1);
             layers += 1;
         }
+        let (upper, lower, _) = current;
         for y in 0..ph {
             let (y0, y1) = (y.saturating_sub(1), (y + 1).min(ph - 1));
+            let (Some(upper_row), Some(lower_row)) = (
+                upper.get(y * pw..(y + 1) * pw),
+                lower.get(y * pw..(y + 1) * pw),
+            ) else {
+                break;
+            };
             for x in 0..pw {
-                let r = response(current, y * pw + x);
+                let r = (i32::from(upper_row[x]) - i32::from(lower_row[x])) * norm;
                 if r < min_response || r <= 0 {
                     continue;
                 }
