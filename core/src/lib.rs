@@ -63,6 +63,23 @@
 //!
 //! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
 //!
+//! ## Frame capacity
+//!
+//! Every scratch is sized by the largest frame it holds, a type parameter
+//! [`FrameCapacity`] (the marker [`capacity::Capacity`]`<W, H>`); 328×248
+//! ([`Reference`]) is the default, so `OtsuScratch` is `OtsuScratch<Reference>`. A
+//! larger frame than the scratch holds is refused with
+//! [`DetectError::FrameTooLarge`](roi::DetectError), never cropped. Bytes on x86-64 at
+//! the supported capacities of larger cores (`tirroi memory` prints them all):
+//!
+//! | detector | 328×248 | 640×512 | 1024×768 |
+//! |---|---|---|---|
+//! | Otsu | 15 216 | 25 688 | 36 056 |
+//! | adaptive | 11 576 | 22 496 | 35 936 |
+//! | WGE | 14 352 | 24 024 | 35 928 |
+//! | DoG | 74 296 | 275 640 | 644 984 |
+//! | auto | 25 456 | 66 448 | 136 208 |
+//!
 //! ## Memory of the camera model
 //!
 //! | piece | bytes |
