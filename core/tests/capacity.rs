@@ -123,29 +123,11 @@ fn wge_at_640x512_matches_the_naive_reference() {
     }
 }
 
-fn disc(w: usize, h: usize, cx: f64, cy: f64, radius: f64) -> (Img, Roi) {
-    let mut img = Img::constant(w, h, 14, 300);
-    for y in 0..h {
-        for x in 0..w {
-            let d = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
-            let v = 300.0 + 9_000.0 / (1.0 + ((d - radius) / 1.5).exp());
-            *img.at(x, y) = v.round() as u16;
-        }
-    }
-    let r = Roi::new(
-        (cx - radius).ceil() as u16,
-        (cy - radius).ceil() as u16,
-        (cx + radius).floor() as u16 + 1,
-        (cy + radius).floor() as u16 + 1,
-    );
-    (img, r)
-}
-
 #[test]
 fn dog_at_640x512_finds_a_disc_and_boxes_its_own_mask() {
     let mut s = Box::new(DogScratch::<Cap640x512>::for_capacity());
     for (cx, cy, r) in [(500.0, 400.0, 30.0), (120.0, 90.0, 16.0)] {
-        let (img, truth) = disc(640, 512, cx, cy, r);
+        let (img, truth) = disc_frame(640, 512, cx, cy, r);
         for rule in RULES {
             let det = Dog {
                 box_rule: rule,
@@ -231,7 +213,7 @@ fn a_larger_capacity_gives_the_same_results_on_reference_frames() {
     for img in [
         textured_frame(&mut rng, 328, 248, 14),
         bimodal_frame(&mut rng, 328, 248, 14, 0.1),
-        disc(328, 248, 150.0, 110.0, 24.0).0,
+        disc_frame(328, 248, 150.0, 110.0, 24.0).0,
     ] {
         for m in Method::ALL {
             let mut p = m.default_params();

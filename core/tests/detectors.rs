@@ -638,30 +638,10 @@ fn wge_rejects_invalid_drop_fractions() {
 // DoG
 // =================================================================================
 
-/// A 328x248 dark frame with a bright soft-edged disc; returns it and the disc's box
-/// (pixels within `radius` of the centre).
-fn disc_frame(cx: f64, cy: f64, radius: f64) -> (Img, Roi) {
-    let mut img = Img::constant(W, H, 14, 300);
-    for y in 0..H {
-        for x in 0..W {
-            let d = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
-            let v = 300.0 + 9_000.0 / (1.0 + ((d - radius) / 1.5).exp());
-            *img.at(x, y) = v.round() as u16;
-        }
-    }
-    let r = Roi::new(
-        (cx - radius).ceil() as u16,
-        (cy - radius).ceil() as u16,
-        (cx + radius).floor() as u16 + 1,
-        (cy + radius).floor() as u16 + 1,
-    );
-    (img, r)
-}
-
 #[test]
 fn dog_finds_a_bright_disc() {
     for (cx, cy, radius) in [(150.0, 110.0, 24.0), (60.0, 200.0, 12.0)] {
-        let (img, disc) = disc_frame(cx, cy, radius);
+        let (img, disc) = disc_frame(W, H, cx, cy, radius);
         for rule in RULES {
             let det = Dog {
                 box_rule: rule,
@@ -697,7 +677,7 @@ fn dog_box_matches_the_scale_of_the_target() {
         (164.0, 124.0, 16.0),
         (250.0, 70.0, 40.0),
     ] {
-        let (img, disc) = disc_frame(cx, cy, radius);
+        let (img, disc) = disc_frame(W, H, cx, cy, radius);
         let d = detect(Dog::default(), &img).unwrap();
         let roi = d.roi.expect("DoG finds the disc");
         let iou = roi.iou(&disc);

@@ -980,3 +980,24 @@ pub fn fixture_imgs() -> Vec<(&'static str, Img)> {
         .map(|&(name, file)| (name, read_png14(&dir.join(file))))
         .collect()
 }
+
+/// A `w`×`h` dark frame (300 DN) with a bright soft-edged disc (9 300 DN inside, a
+/// logistic edge 1.5 px wide); returns it and the disc's box (pixels within `radius`
+/// of the centre).
+pub fn disc_frame(w: usize, h: usize, cx: f64, cy: f64, radius: f64) -> (Img, Roi) {
+    let mut img = Img::constant(w, h, 14, 300);
+    for y in 0..h {
+        for x in 0..w {
+            let d = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
+            let v = 300.0 + 9_000.0 / (1.0 + ((d - radius) / 1.5).exp());
+            *img.at(x, y) = v.round() as u16;
+        }
+    }
+    let r = Roi::new(
+        (cx - radius).ceil() as u16,
+        (cy - radius).ceil() as u16,
+        (cx + radius).floor() as u16 + 1,
+        (cy + radius).floor() as u16 + 1,
+    );
+    (img, r)
+}
