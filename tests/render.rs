@@ -34,6 +34,8 @@ fn input<'a>(
         noise_seed: None,
         band: &band.0,
         lut: &band.1,
+        gain_factor: 1.0,
+        moon: None,
     }
 }
 

@@ -59,10 +59,34 @@ pub struct ImageRecord {
     pub noise_sigma_dn: f32,
     /// Noise seed.
     pub noise_seed: Option<u64>,
+    /// Bit depth of the DN map (scene `bits`, else the camera's): the PNG is 16-bit,
+    /// saturation is at 2^bits − 1.
+    #[serde(default = "default_bits")]
+    pub bits: u8,
+    /// Factor on the mode's DN gain (scene `gain`).
+    #[serde(default = "unit")]
+    pub gain_factor: f64,
+    /// NETD the noise is scaled to, K (camera NETD × scene `noise_netd_factor`).
+    #[serde(default)]
+    pub netd_k: f64,
+    /// Whether the Moon is in the field of view (scene `moon`).
+    #[serde(default)]
+    pub moon_in_view: bool,
+    /// Pixels whose centre sees the Moon (0 when it is not in view or hidden).
+    #[serde(default)]
+    pub moon_px: usize,
     /// Coldest and hottest target facet, K.
     pub target_temperature_k: [f64; 2],
     /// Dataset seed.
     pub dataset_seed: u64,
+}
+
+fn default_bits() -> u8 {
+    tirroi_core::frame::DEFAULT_BIT_DEPTH
+}
+
+fn unit() -> f64 {
+    1.0
 }
 
 pub(super) fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
@@ -123,6 +147,11 @@ fn record(
         dn_offset: frame.mapping.offset_dn(),
         noise_sigma_dn: frame.noise_sigma_dn,
         noise_seed: plan.noise_seed,
+        bits: frame.mapping.bits(),
+        gain_factor: plan.gain_factor,
+        netd_k: file.camera.netd_k * plan.netd_factor,
+        moon_in_view: plan.moon.is_some(),
+        moon_px: frame.moon_px,
         target_temperature_k: [thermal.min_max_k.0, thermal.min_max_k.1],
         dataset_seed: file.dataset.seed,
     }
@@ -164,7 +193,7 @@ pub(super) fn write_image(
             pixels: frame.dn.clone(),
             width: frame.width,
             height: frame.height,
-            bits: file.camera.bits,
+            bits: frame.mapping.bits(),
         };
         let img = overlay::frame_with_boxes(&buf, &[(frame.truth, overlay::TRUTH_COLOUR)], 2);
         let path = dir.join("preview").join(&rec.file);

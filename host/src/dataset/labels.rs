@@ -15,7 +15,7 @@ pub(super) fn write_labels<'a>(
     records: impl Iterator<Item = &'a ImageRecord>,
 ) -> Result<(), DatasetError> {
     let mut csv = String::from(
-        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed\n",
+        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits\n",
     );
     let mut jsonl = String::new();
     let mut images = Vec::new();
@@ -23,7 +23,7 @@ pub(super) fn write_labels<'a>(
     for r in records {
         let [x0, y0, x1, y1] = r.bbox;
         csv.push_str(&format!(
-            "{},{x0},{y0},{x1},{y1},{},{},{},{},{},{:.3},{:.4},{}\n",
+            "{},{x0},{y0},{x1},{y1},{},{},{},{},{},{:.3},{:.4},{},{}\n",
             r.file,
             r.mode,
             r.scale.map_or(String::new(), |s| s.to_string()),
@@ -33,6 +33,7 @@ pub(super) fn write_labels<'a>(
             r.range_m,
             r.earth_fraction,
             r.noise_seed.map_or(String::new(), |s| s.to_string()),
+            r.bits,
         ));
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');

@@ -10,12 +10,14 @@ use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
 
 use super::DatasetError;
 use super::plan::{ImagePlan, ThermalKey};
-use crate::imaging::render::{self, EarthView, Readout, RenderInput, Rendered, TargetView};
+use crate::imaging::render::{
+    self, EarthView, MoonView, Readout, RenderInput, Rendered, TargetView,
+};
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::earth::{EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
-use crate::world::scene::{EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::scene::{Camera, EarthSource, Illumination, SceneFile, TargetModel};
 use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
 };
@@ -223,8 +225,14 @@ impl Library {
         } else {
             None
         };
+        // The pose's bit depth and NETD (scene `bits`, `noise_netd_factor`).
+        let camera = Camera {
+            bits: plan.bits,
+            netd_k: file.camera.netd_k * plan.netd_factor,
+            ..file.camera
+        };
         let input = RenderInput {
-            camera: &file.camera,
+            camera: &camera,
             readout: match plan.scale {
                 None => Readout::Radiometry,
                 Some(2) => Readout::Detection(DetectionScale::Scale2),
@@ -242,6 +250,11 @@ impl Library {
             noise_seed: plan.noise_seed,
             band: &self.band,
             lut: &self.lut,
+            gain_factor: plan.gain_factor,
+            moon: plan.moon.map(|m| MoonView {
+                dir_camera: m.dir_camera,
+                sun_dir_camera: m.sun_dir_camera,
+            }),
         };
         let frame = render::render(&input)
             .map_err(|e| DatasetError(format!("image {}: {e}", plan.index)))?;

@@ -40,7 +40,7 @@ mod plan;
 
 pub use images::ImageRecord;
 pub use library::{Library, ThermalState};
-pub use plan::{ImagePlan, ThermalKey, plan};
+pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
 use images::write_image;
 use labels::write_labels;

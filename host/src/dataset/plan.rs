@@ -44,6 +44,57 @@ pub struct ImagePlan {
     pub earth_day: usize,
     /// Noise seed (`None`: noise off).
     pub noise_seed: Option<u64>,
+    /// Factor on the DN map's gain (scene `gain`, 1 by default).
+    pub gain_factor: f64,
+    /// Factor on the camera's NETD for the noise (scene `noise_netd_factor`, 1 by default).
+    pub netd_factor: f64,
+    /// Bit depth of the DN map (scene `bits`, else the camera's).
+    pub bits: u8,
+    /// The Moon, when it is in the field of view.
+    pub moon: Option<MoonPlan>,
+}
+
+/// Where the Moon is and where its Sun is, camera frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoonPlan {
+    /// Unit direction to the Moon's centre.
+    pub dir_camera: Vec3,
+    /// Unit direction to the Sun (the same from the camera and the Moon): the scene's
+    /// Sun when sunlit; in eclipse the Sun is behind the Earth, so the direction to the
+    /// Earth's centre.
+    pub sun_dir_camera: Vec3,
+}
+
+/// How far into the frame an edge-cut target still reaches, px: random offsets beyond
+/// the frame (`max_offset_fraction` > 1) are pulled back until a disc of the target's
+/// inner half-size reaches this far in (or, when that disc is smaller, until the
+/// centre is this far minus the disc radius inside the edge).
+pub const EDGE_CUT_KEEP_PX: f64 = 2.0;
+
+/// `offset` (px from the frame centre) pulled back so that the disc of radius
+/// `inner_px` about it reaches [`EDGE_CUT_KEEP_PX`] into the frame of half-size
+/// `half` (the nearest such point; unchanged when it already does).
+pub fn keep_in_view(offset: [f64; 2], half: [f64; 2], inner_px: f64) -> [f64; 2] {
+    let limit = inner_px - EDGE_CUT_KEEP_PX;
+    if limit < 0.0 {
+        // The centre itself must be -limit inside the edges.
+        let c = |v: f64, h: f64| {
+            let m = (h + limit).max(0.0);
+            v.clamp(-m, m)
+        };
+        return [c(offset[0], half[0]), c(offset[1], half[1])];
+    }
+    let p = [
+        offset[0].clamp(-half[0], half[0]),
+        offset[1].clamp(-half[1], half[1]),
+    ];
+    let v = [offset[0] - p[0], offset[1] - p[1]];
+    let d = v[0].hypot(v[1]);
+    if d <= limit {
+        offset
+    } else {
+        [p[0] + v[0] * limit / d, p[1] + v[1] * limit / d]
+    }
 }
 
 /// Identifies a thermal solution: target, material, resolution, illumination and the
@@ -135,6 +186,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         let poses = spec.count / scales.len();
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
+        let focal_px = file.camera.focal_px();
         for pose in 0..poses {
             let mut rng = rng_for(seed, si as u64 + 1, pose as u64);
             let combo = pose % (materials.len() * lights.len());
@@ -146,10 +198,20 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 file.camera.height as f64 / 2.0 * spec.max_offset_fraction,
             ];
             let offset_px = spec.offset_px.unwrap_or_else(|| {
-                [
+                let o = [
                     rng.gen_range(-1.0..=1.0) * fov_half[0],
                     rng.gen_range(-1.0..=1.0) * fov_half[1],
-                ]
+                ];
+                if spec.max_offset_fraction > 1.0 {
+                    let half = [
+                        file.camera.width as f64 / 2.0,
+                        file.camera.height as f64 / 2.0,
+                    ];
+                    let inner_px = spec.target.inner_half_size_m() / range_m * focal_px;
+                    keep_in_view(o, half, inner_px)
+                } else {
+                    o
+                }
             });
             let off = spec
                 .earth_off_boresight_deg
@@ -184,6 +246,29 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
             let camera_to_earth = Rotation::about_axis(up, heading)
                 .then(&Rotation::between(scale(earth_dir_camera, -1.0), up));
             let earth_day = rng.gen_range(0..file.earth_model.days);
+            // The variety knobs draw after every draw above, so those keep their values.
+            let gain_factor = spec.gain.sample(rng.r#gen());
+            let netd_factor = spec.noise_netd_factor.sample(rng.r#gen());
+            let bits = spec.bits.as_ref().map_or(file.camera.bits, |b| {
+                let b = b.values();
+                b[pose % b.len()]
+            });
+            let moon = spec.moon.and_then(|m| {
+                let u: f64 = rng.r#gen();
+                let x = rng.gen_range(0.0..file.camera.width as f64);
+                let y = rng.gen_range(0.0..file.camera.height as f64);
+                (u < m.probability).then(|| MoonPlan {
+                    dir_camera: normalize([
+                        (x - file.camera.width as f64 / 2.0) / focal_px,
+                        (y - file.camera.height as f64 / 2.0) / focal_px,
+                        1.0,
+                    ]),
+                    sun_dir_camera: match sun_body {
+                        Some(s) => normalize(body_to_camera.apply(s)),
+                        None => earth_dir_camera,
+                    },
+                })
+            });
             let thermal = ThermalKey {
                 target: spec.target,
                 material,
@@ -213,6 +298,10 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     noise_seed: spec.noise.then(|| {
                         splitmix64(splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))
                     }),
+                    gain_factor,
+                    netd_factor,
+                    bits,
+                    moon,
                 });
             }
         }

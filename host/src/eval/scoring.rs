@@ -32,6 +32,9 @@ pub struct TruthRow {
     pub groups: Vec<(String, String)>,
     /// Camera–target distance, m, when the file has a `range_m` column.
     pub range_m: Option<f64>,
+    /// Bit depth of the frame's DN, when the file has a `bits` column: it takes
+    /// precedence over [`EvalOptions::bits`] for this frame.
+    pub bits: Option<u8>,
 }
 
 /// Columns that become groups; `range_m` becomes `range` (close / mid / far).
@@ -114,12 +117,26 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
         }
         let mut groups = Vec::new();
         let mut range_m = None;
+        let mut bits = None;
         for (name, value) in header.iter().zip(&cols).skip(5) {
             if value.is_empty() {
                 continue;
             }
             if GROUP_COLUMNS.contains(name) {
                 groups.push((name.to_string(), value.to_string()));
+            } else if *name == "bits" {
+                bits = Some(
+                    value
+                        .parse::<u8>()
+                        .ok()
+                        .filter(|b| (1..=16).contains(b))
+                        .ok_or_else(|| {
+                            EvalError(format!(
+                                "{}: bits = `{value}`: expected a bit depth 1..=16",
+                                at()
+                            ))
+                        })?,
+                );
             } else if *name == "range_m" {
                 if let Ok(r) = value.parse::<f64>() {
                     groups.push(("range".into(), range_band(r).into()));
@@ -132,6 +149,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             roi: Roi::new(b[0], b[1], b[2], b[3]),
             groups,
             range_m,
+            bits,
         });
     }
     Ok(rows)
@@ -168,7 +186,8 @@ pub struct EvalOptions {
     /// Mask-to-box rule for every detector; `None` keeps each detector's own rule from
     /// `make_bank` (e.g. tuned per method).
     pub box_rule: Option<BoxRule>,
-    /// Bit depth of the frames (None: from the file, 14 for 16-bit files that fit).
+    /// Bit depth of the frames without a `bits` column in `truth.csv` (None: from the
+    /// file, 14 for 16-bit files that fit); a row's own `bits` wins.
     pub bits: Option<u8>,
     /// Where `auto` gets its tracking prior (the other methods have none).
     pub track: Track,
@@ -238,8 +257,8 @@ pub fn score(
             },
             |bank, row| {
                 let path: PathBuf = images.join(&row.file);
-                let frame =
-                    read_frame(&path, options.bits).map_err(|e| EvalError(e.to_string()))?;
+                let frame = read_frame(&path, row.bits.or(options.bits))
+                    .map_err(|e| EvalError(e.to_string()))?;
                 let view = frame
                     .view()
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
@@ -307,7 +326,8 @@ fn score_sequence(
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
-        let frame = read_frame(&path, options.bits).map_err(|e| EvalError(e.to_string()))?;
+        let frame =
+            read_frame(&path, row.bits.or(options.bits)).map_err(|e| EvalError(e.to_string()))?;
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;

@@ -23,10 +23,15 @@
 //! frame whose field of view cannot reach the Earth's disc, nor for pixels fully on the
 //! target; pixels at the limb are supersampled like the target's edges.
 //!
+//! **Moon.** Optionally a background disc behind the target and the Earth ([`moon`]).
+//!
 //! **Readout.** Radiometry mode turns q into F = D·q (Eq. 7) with D = π|r|²/ΔA_c per
 //! object (target: distance to its centre; Earth: to its centre) and auto-ranges the DN
 //! map over the frame's pure (unmixed) pixels (Eq. 17); detection mode uses the fixed
-//! Table 5 scale (Eq. 9). The core's [`expose_frame`] then adds the noise (Eq. 18,
+//! Table 5 scale (Eq. 9). A gain factor ([`RenderInput::gain_factor`]) then multiplies
+//! the map's gain a: detection, a = factor·(2ⁿ − 1)/q_max; radiometry, about the
+//! frame's minimum F (kept at DN 0), so a factor above 1 clips the brightest pixels.
+//! The core's [`expose_frame`] then adds the noise (Eq. 18,
 //! scaled to the NETD) and quantises.
 
 use std::time::Instant;
@@ -45,9 +50,12 @@ use crate::world::scene::Camera;
 use crate::world::spacecraft::Mesh;
 
 mod earth;
+mod moon;
 mod target;
 
 use earth::render_earth;
+pub use moon::MoonView;
+use moon::render_moon;
 use target::{Range, render_target};
 
 /// Sub-samples per axis on a partial pixel (4 × 4 = 16 per pixel).
@@ -115,6 +123,10 @@ pub struct RenderInput<'a> {
     pub band: &'a BandRadiance,
     /// Band radiance table (per facet and Earth cell radiances).
     pub lut: &'a BandLut,
+    /// Factor on the DN map's gain a (module docs; 1: the map of the mode as is).
+    pub gain_factor: f64,
+    /// The Moon, if in the field of view.
+    pub moon: Option<MoonView>,
 }
 
 /// Time spent and work done per stage of one frame.
@@ -151,6 +163,8 @@ pub struct Rendered {
     pub truth: Roi,
     /// Fraction of the frame's pixels whose centre sees the Earth (not the target).
     pub earth_fraction: f64,
+    /// Pixels whose centre sees the Moon (not the target, not the Earth).
+    pub moon_px: usize,
     /// The DN map used.
     pub mapping: DnMapping,
     /// Total noise σ, DN (0 without noise).
@@ -257,6 +271,19 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     stats.target_ns = t0.elapsed().as_nanos() as u64;
 
     let t1 = Instant::now();
+    let mut moon_px = 0usize;
+    if let Some(moon) = &input.moon {
+        moon_px = render_moon(
+            &cam,
+            moon,
+            input.earth.as_ref(),
+            input.readout,
+            input.lut,
+            &coverage,
+            &mut signal,
+            &mut pure,
+        )?;
+    }
     let mut earth_px = 0usize;
     if let Some(earth) = &input.earth {
         earth_px = render_earth(
@@ -294,6 +321,20 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
             };
             DnMapping::radiometry_auto(lo, hi, bits)?
         }
+    };
+    let g = input.gain_factor;
+    if !(g.is_finite() && g > 0.0) {
+        return Err(RenderError::Input(format!(
+            "gain factor {g}: expected a finite number > 0"
+        )));
+    }
+    let mapping = if g == 1.0 {
+        mapping
+    } else {
+        // About the signal that maps to DN 0 (radiometry: the frame's minimum F).
+        let zero_signal = mapping.signal(0.0);
+        let gain = mapping.gain_dn() * g;
+        DnMapping::new(gain, 0.0 - gain * zero_signal, bits)?
     };
     let mut noise_sigma_dn = 0.0;
     let mut field = match input.noise_seed {
@@ -339,6 +380,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
         coverage,
         truth,
         earth_fraction: earth_px as f64 / n as f64,
+        moon_px,
         mapping,
         noise_sigma_dn,
         stats,

@@ -52,6 +52,18 @@ impl TargetModel {
             TargetModel::Tango => 0.05,
         }
     }
+
+    /// Radius of a ball about the body origin (the target's centre) that lies inside
+    /// the target, m: its projection lies inside the silhouette at any attitude, which
+    /// is what keeps an edge-cut target in view. Cube + cylinder: 0.25 m (the origin is
+    /// the centre of the joint face; the Ø 0.5 m cylinder and the 1 m cube hold the
+    /// ball). Tango: 0.14 m (the 0.295 m bus, the origin within 3 mm of its mid-plane).
+    pub fn inner_half_size_m(&self) -> f64 {
+        match self {
+            TargetModel::CubeCylinder => 0.25,
+            TargetModel::Tango => 0.14,
+        }
+    }
 }
 
 /// Whether the Sun lights the target and the Earth (Section 3.2.2).
@@ -127,6 +139,14 @@ impl fmt::Display for Param {
             Param::Range { min, max } => write!(f, "{{ min = {min}, max = {max} }}"),
         }
     }
+}
+
+/// Whether the Moon may appear in the field of view (a background disc, [`crate::world::moon`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MoonSpec {
+    /// Probability that a pose has the Moon in its field, 0..=1.
+    pub probability: f64,
 }
 
 /// One value, or a list that consecutive poses cycle through.

@@ -36,8 +36,8 @@ mod spec;
 mod tests;
 
 pub use camera::Camera;
-pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
-pub use spec::{DatasetSettings, EarthModel, EarthSource, SceneSpec};
+pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel};
+pub use spec::{DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION, SceneSpec};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::DetectionScale;
 
-use super::kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
+use super::kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel};
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
 use crate::world::spacecraft::MaterialCase;
@@ -117,6 +117,10 @@ impl Default for DatasetSettings {
     }
 }
 
+/// Largest `max_offset_fraction`: 1.5 half-frames (the target's centre up to a quarter
+/// frame outside the edge, then pulled back to keep part of it in view).
+pub const MAX_OFFSET_FRACTION: f64 = 1.5;
+
 /// One kind of scene: `count` images sharing these settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -153,7 +157,11 @@ pub struct SceneSpec {
     /// down); omitted: uniform within the central `max_offset_fraction` of the frame.
     #[serde(default)]
     pub offset_px: Option<[f64; 2]>,
-    /// Random offsets stay within this fraction of the half-frame (0..=1, default 0.6).
+    /// Random offsets stay within this fraction of the half-frame (0..=1.5, default
+    /// 0.6). Above 1 the target's centre can leave the frame and the target is cut by
+    /// its edge; the centre is then pulled back so that a disc of the target's inner
+    /// half-size ([`TargetModel::inner_half_size_m`]) still reaches 2 px into the frame
+    /// (the dataset's `EDGE_CUT_KEEP_PX`): never a frame without the target.
     #[serde(default = "max_offset")]
     pub max_offset_fraction: f64,
     /// Sunlit or eclipse (one, or a list the poses cycle through).
@@ -179,6 +187,26 @@ pub struct SceneSpec {
     /// Image-plane direction towards the Earth's centre, degrees from +x towards +y.
     #[serde(default = "full_circle")]
     pub earth_azimuth_deg: Param,
+    /// Factor on the DN map's gain a (0.05..=20, default 1). Detection: the Table 5
+    /// scale's gain × factor (offset 0): the Earth's warmest cell (2.07e-17 W m⁻², 69 %
+    /// of Scale 1) sits at 0.69 × factor of full scale on Scale 1 (clipped above factor
+    /// 1.45), and a hot target saturates sooner. Radiometry: the auto range
+    /// (Eq. 17) is computed, then its gain is multiplied about the frame's minimum F
+    /// (which stays at DN 0): above 1 the brightest pure pixels clip at 2ⁿ − 1, below 1
+    /// the scene spans only `factor` of the DN range.
+    #[serde(default = "unit")]
+    pub gain: Param,
+    /// Factor on the camera's NETD the noise is scaled to (0..=100, default 1): the
+    /// frame's NETD is `camera.netd_k × factor`.
+    #[serde(default = "unit")]
+    pub noise_netd_factor: Param,
+    /// Bit depth of the DN map per pose (1..=16; a list is cycled through by the poses);
+    /// omitted: `camera.bits`. The PNG stays 16-bit; `truth.csv` has a `bits` column.
+    #[serde(default)]
+    pub bits: Option<OneOrMany<u8>>,
+    /// The Moon in the field of view with some probability (omitted: never).
+    #[serde(default)]
+    pub moon: Option<MoonSpec>,
 }
 
 fn one() -> usize {
@@ -207,6 +235,9 @@ fn yes() -> bool {
 }
 fn earth_distance() -> f64 {
     EARTH_DISTANCE_M / 1e3
+}
+fn unit() -> Param {
+    Param::Fixed(1.0)
 }
 fn off_boresight() -> Param {
     Param::Range {
@@ -300,9 +331,9 @@ impl SceneSpec {
                 ));
             }
         }
-        if !(0.0..=1.0).contains(&self.max_offset_fraction) {
+        if !(0.0..=MAX_OFFSET_FRACTION).contains(&self.max_offset_fraction) {
             return Err(format!(
-                "{at}.max_offset_fraction = {}: expected 0..=1",
+                "{at}.max_offset_fraction = {}: expected 0..={MAX_OFFSET_FRACTION} (above 1 the target is cut by the frame edge)",
                 self.max_offset_fraction
             ));
         }
@@ -333,6 +364,25 @@ impl SceneSpec {
         )?;
         self.earth_azimuth_deg
             .validate(&format!("{at}.earth_azimuth_deg"), -360.0, 720.0)?;
+        self.gain.validate(&format!("{at}.gain"), 0.05, 20.0)?;
+        self.noise_netd_factor
+            .validate(&format!("{at}.noise_netd_factor"), 0.0, 100.0)?;
+        if let Some(bits) = &self.bits {
+            let b = bits.values();
+            if b.is_empty() || b.iter().any(|v| !(1..=16).contains(v)) {
+                return Err(format!(
+                    "{at}.bits = {b:?}: expected a bit depth 1..=16 (e.g. 12, 14, 16) or a non-empty list of them"
+                ));
+            }
+        }
+        if let Some(m) = self.moon {
+            if !(0.0..=1.0).contains(&m.probability) {
+                return Err(format!(
+                    "{at}.moon.probability = {}: expected 0..=1",
+                    m.probability
+                ));
+            }
+        }
         Ok(())
     }
 }
