@@ -59,7 +59,7 @@ pub(super) fn render_moon(
 ) -> Result<usize, RenderError> {
     let dir = normalize(moon.dir_camera);
     let sun = normalize(moon.sun_dir_camera);
-    if !(dir[2] > 0.0) || sun.iter().any(|v| !v.is_finite()) {
+    if dir[2].is_nan() || dir[2] <= 0.0 || sun.iter().any(|v| !v.is_finite()) {
         return Err(RenderError::Input(format!(
             "the Moon's direction {:?} is not in front of the camera (or its Sun {:?} is not a direction)",
             moon.dir_camera, moon.sun_dir_camera
