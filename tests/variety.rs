@@ -388,3 +388,28 @@ fn the_moon_is_a_10_px_disc_at_390_k_by_day_and_100_k_by_night() {
     let hidden = moon_frame(&b, u, v, dir, Some(earth));
     assert_eq!(hidden.moon_px, 0);
 }
+
+#[test]
+fn a_bad_bits_column_is_named_with_its_line() {
+    let dir = std::env::temp_dir().join(format!("tirroi-variety-bits-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("truth.csv");
+    std::fs::write(
+        &path,
+        "file,x0,y0,x1,y1,bits\na.png,1,2,3,4,12\nb.png,1,2,3,4,20\n",
+    )
+    .unwrap();
+    let e = read_truth(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("truth.csv:3") && e.contains("bits = `20`"),
+        "{e}"
+    );
+    std::fs::write(
+        &path,
+        "file,x0,y0,x1,y1,bits\na.png,1,2,3,4,12\nb.png,1,2,3,4,\n",
+    )
+    .unwrap();
+    let rows = read_truth(&path).unwrap();
+    assert_eq!((rows[0].bits, rows[1].bits), (Some(12), None));
+    let _ = std::fs::remove_dir_all(&dir);
+}
