@@ -72,9 +72,13 @@ pub struct ImageRecord {
     /// Whether the Moon is in the field of view (scene `moon`).
     #[serde(default)]
     pub moon_in_view: bool,
-    /// Pixels whose centre sees the Moon (0 when it is not in view or hidden).
+    /// Pixels whose centre sees the Moon (0 when it is not in view or hidden by the
+    /// Earth).
     #[serde(default)]
     pub moon_px: usize,
+    /// Direction to the Moon's centre in the camera frame (when in view).
+    #[serde(default)]
+    pub moon_dir_camera: Option<Vec3>,
     /// Coldest and hottest target facet, K.
     pub target_temperature_k: [f64; 2],
     /// Dataset seed.
@@ -152,6 +156,7 @@ fn record(
         netd_k: file.camera.netd_k * plan.netd_factor,
         moon_in_view: plan.moon.is_some(),
         moon_px: frame.moon_px,
+        moon_dir_camera: plan.moon.map(|m| m.dir_camera),
         target_temperature_k: [thermal.min_max_k.0, thermal.min_max_k.1],
         dataset_seed: file.dataset.seed,
     }
