@@ -244,6 +244,8 @@ fn explain(message: &str, key: Option<&str>) -> String {
         "illumination" => Some("\"sunlit\", \"eclipse\", or a list of them"),
         "scale" => Some("1, 2, 3, or a list of them"),
         "source" => Some("\"builtin\" or \"netcdf\""),
+        "bits" => Some("a bit depth 1..=16, or a list of them"),
+        "moon" => Some("a table { probability = <0..1> }"),
         _ => None,
     };
     match accepted {
