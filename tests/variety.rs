@@ -11,7 +11,7 @@ use tirroi::core::Roi;
 use tirroi::core::sensor::flux::SENSOR_AREA_M2;
 use tirroi::core::sensor::{BandLut, BandRadiance, DetectionScale};
 use tirroi::host::dataset::{WriteOptions, keep_in_view, plan, write_dataset};
-use tirroi::host::eval::scoring::read_truth;
+use tirroi::host::eval::scoring::{read_row_frame, read_truth};
 use tirroi::host::imaging::image_io::read_frame;
 use tirroi::host::imaging::render::{
     EarthView, MoonView, Readout, RenderInput, Rendered, TargetView, render,
@@ -292,8 +292,12 @@ fn edge_cut_datasets_never_lose_the_target_and_record_the_bit_depth_eval_reads()
         );
         let bits = [12, 16][k % 2];
         assert_eq!(row.bits, Some(bits));
-        let frame = read_frame(&dir.join(&row.file), row.bits).unwrap();
+        // What eval and tune read: the row's depth, even against an explicit --bits 14.
+        let frame = read_row_frame(&dir, row, Some(14)).unwrap();
         assert_eq!(frame.bits, bits);
+        // Without the column, a 12-bit frame would be taken for 14-bit.
+        let guessed = read_frame(&dir.join(&row.file), None).unwrap();
+        assert_eq!(guessed.bits, if bits == 12 { 14 } else { 16 });
         assert!(u32::from(*frame.pixels.iter().max().unwrap()) < 1 << bits);
     }
     eprintln!("{at_edge} of 16 truth boxes touch the frame edge");

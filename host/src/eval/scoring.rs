@@ -257,8 +257,7 @@ pub fn score(
             },
             |bank, row| {
                 let path: PathBuf = images.join(&row.file);
-                let frame = read_frame(&path, row.bits.or(options.bits))
-                    .map_err(|e| EvalError(e.to_string()))?;
+                let frame = read_row_frame(images, row, options.bits)?;
                 let view = frame
                     .view()
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
@@ -279,6 +278,19 @@ pub fn score(
         scores.extend(r?);
     }
     Ok(scores)
+}
+
+/// Reads the frame of `row` from `images` at the row's own bit depth (`truth.csv`'s
+/// `bits` column), else at `bits` (else as [`read_frame`] infers it).
+///
+/// # Errors
+/// [`EvalError`] naming the file when it cannot be read.
+pub fn read_row_frame(
+    images: &Path,
+    row: &TruthRow,
+    bits: Option<u8>,
+) -> Result<crate::imaging::image_io::FrameBuf, EvalError> {
+    read_frame(&images.join(&row.file), row.bits.or(bits)).map_err(|e| EvalError(e.to_string()))
 }
 
 /// Runs `method` on one frame (`repeat` times, median time) and scores its box against
@@ -326,8 +338,7 @@ fn score_sequence(
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
-        let frame =
-            read_frame(&path, row.bits.or(options.bits)).map_err(|e| EvalError(e.to_string()))?;
+        let frame = read_row_frame(images, row, options.bits)?;
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
