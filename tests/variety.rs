@@ -469,3 +469,35 @@ fn a_sub_pixel_boom_covers_its_projected_area() {
         assert!(max < 1.0);
     }
 }
+
+#[test]
+fn variety_fields_parse_and_bad_values_name_the_field() {
+    let base = "[[scene]]\nrange_m = 20.0\n";
+    let ok = SceneFile::parse(
+        &format!("{base}gain = {{ min = 0.5, max = 2.0 }}\nnoise_netd_factor = 3.0\nbits = [12, 16]\nmax_offset_fraction = 1.3\nmoon = {{ probability = 0.1 }}\n"),
+        "t",
+    )
+    .unwrap();
+    assert_eq!(ok.scenes[0].moon.unwrap().probability, 0.1);
+    for (line, expect) in [
+        ("gain = 0.0", "scene[0].gain = 0"),
+        ("gain = { min = 0.5, max = 40.0 }", "scene[0].gain"),
+        ("noise_netd_factor = -1.0", "scene[0].noise_netd_factor"),
+        ("bits = [12, 20]", "scene[0].bits = [12, 20]"),
+        ("bits = []", "scene[0].bits = []"),
+        (
+            "max_offset_fraction = 1.6",
+            "scene[0].max_offset_fraction = 1.6",
+        ),
+        (
+            "moon = { probability = 1.5 }",
+            "scene[0].moon.probability = 1.5",
+        ),
+        ("moon = { chance = 0.1 }", "chance"),
+    ] {
+        let e = SceneFile::parse(&format!("{base}{line}\n"), "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(expect) && !e.contains('\n'), "{line}: {e}");
+    }
+}

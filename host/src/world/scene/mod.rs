@@ -22,6 +22,12 @@
 //! range_m = { min = 15.0, max = 50.0 }
 //! illumination = ["sunlit", "eclipse"]
 //! earth_off_boresight_deg = 30.0
+//! # Variety (optional; omitted they change nothing): docs/scenes.md
+//! gain = { min = 0.5, max = 2.0 }   # factor on the DN map's gain
+//! noise_netd_factor = { min = 0.5, max = 3.0 }
+//! bits = [12, 14, 16]
+//! max_offset_fraction = 1.3         # > 1: targets cut by the frame edge
+//! moon = { probability = 0.1 }
 //! ```
 
 use std::fmt;
