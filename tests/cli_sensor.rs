@@ -56,10 +56,55 @@ fn flat_response_radiance_is_sigma_t4_over_pi() {
     assert!((f / (std::f64::consts::PI * got) - 1.0).abs() <= 1e-15);
 }
 
+/// (T, L) rows of one of the core's 30-digit reference tables.
+fn reference_rows(text: &str) -> Vec<(f64, f64)> {
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("t_k"))
+        .filter_map(|l| {
+            let (t, v) = l.split_once(',')?;
+            Some((t.parse().ok()?, v.trim().parse().ok()?))
+        })
+        .collect()
+}
+
+#[test]
+fn hayabusa2_and_tir_responses_print_their_reference_radiances() {
+    let measured = reference_rows(include_str!(
+        "../core/tests/data/band_radiance_hayabusa2_reference.csv"
+    ));
+    let bell = reference_rows(include_str!(
+        "../core/tests/data/band_radiance_reference.csv"
+    ));
+    for (name, table) in [("hayabusa2", &measured), ("tir", &bell)] {
+        let v = sensor_json(&["--response", name, "--temps", "150,200,300,400,500"]);
+        assert_eq!(v["response"], name);
+        let rows = v["temperatures"].as_array().expect("temperatures array");
+        assert_eq!(rows.len(), 5);
+        for r in rows {
+            let t = num(r, "t_k");
+            let want = table
+                .iter()
+                .find(|row| row.0 == t)
+                .unwrap_or_else(|| panic!("{t} K not in the {name} reference"))
+                .1;
+            let got = num(r, "radiance_w_m2_sr");
+            assert!(
+                (got / want - 1.0).abs() <= 1e-9,
+                "{name}, {t} K: {got} vs {want}"
+            );
+        }
+    }
+    // The default is the measured curve, and it is not the bell's: 11 % less at 300 K.
+    let default = sensor_json(&["--temps", "300"]);
+    assert_eq!(default["response"], "hayabusa2");
+    let l = num(&default["temperatures"][0], "radiance_w_m2_sr");
+    assert!((l - 29.6172).abs() < 1e-3, "{l}");
+}
+
 #[test]
 fn defaults_give_table2_netd_and_a_monotone_round_trip() {
     let v = sensor_json(&[]);
-    assert_eq!(v["response"], "tir");
+    assert_eq!(v["response"], "hayabusa2");
     assert_eq!(v["level"], "netd");
     assert_eq!(v["bits"], 14);
     let noise = &v["noise"];

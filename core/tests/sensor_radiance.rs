@@ -1,15 +1,26 @@
 //! Band radiance of the three paths (exact f64, f32, table) against the 30-digit
-//! reference table `tests/data/band_radiance_reference.csv`, written once by
-//! `scripts/reference/band_radiance.py` (mpmath, two independent quadratures), and the
-//! flat response against σT⁴/π.
+//! reference tables: `tests/data/band_radiance_reference.csv` of the analytic bell,
+//! written once by `scripts/reference/band_radiance.py` (mpmath, two independent
+//! quadratures), and `tests/data/band_radiance_hayabusa2_reference.csv` of the measured
+//! Hayabusa2 TIR response, written by `scripts/reference/band_radiance_hayabusa2.py`
+//! (mpmath, 24- and 12-point rules per 0.01 µm sample interval); and the flat response
+//! against σT⁴/π.
 
 use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 use tirroi_core::sensor::{BandLut, BandRadiance, CameraResponse, DnMapping};
 
-/// (T in K, L in W m⁻² sr⁻¹) from the reference table, parsed as f64 (the 30 digits
-/// round to the nearest f64, 1e-16 relative: far below every bound tested here).
+/// (T in K, L in W m⁻² sr⁻¹) from the bell's reference table, parsed as f64 (the 30
+/// digits round to the nearest f64, 1e-16 relative: far below every bound tested here).
 fn reference() -> Vec<(f64, f64)> {
-    let text = include_str!("data/band_radiance_reference.csv");
+    parse_reference(include_str!("data/band_radiance_reference.csv"))
+}
+
+/// The same for the measured Hayabusa2 TIR response.
+fn reference_measured() -> Vec<(f64, f64)> {
+    parse_reference(include_str!("data/band_radiance_hayabusa2_reference.csv"))
+}
+
+fn parse_reference(text: &str) -> Vec<(f64, f64)> {
     let rows: Vec<(f64, f64)> = text
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("t_k"))
@@ -29,7 +40,7 @@ fn rel(a: f64, b: f64) -> f64 {
 
 #[test]
 fn f64_path_within_1e9_from_1_5_k_to_5000_k() {
-    let band = BandRadiance::hayabusa2_tir();
+    let band = BandRadiance::hayabusa2_tir_bell();
     let mut worst = (0.0, 0.0);
     for (t, want) in reference() {
         let got = band.radiance_w_m2_sr(t, 1.0).unwrap();
@@ -52,12 +63,26 @@ fn f64_path_within_1e9_from_1_5_k_to_5000_k() {
 
 #[test]
 fn f32_paths_within_1e5_where_l_is_a_normal_f32() {
-    let band = BandRadiance::hayabusa2_tir();
-    let lut = BandLut::new(&band);
+    let band = BandRadiance::hayabusa2_tir_bell();
+    check_f32_paths(&band, &reference());
+}
+
+#[test]
+fn measured_response_f32_paths_within_1e5_where_l_is_a_normal_f32() {
+    check_f32_paths(&BandRadiance::hayabusa2_tir(), &reference_measured());
+}
+
+/// The f32 quadrature and the table within 1e-5 relative wherever L is a normal f32,
+/// ln L within 1e-4 absolute from 3 K, at every f32-exact reference temperature.
+fn check_f32_paths(band: &BandRadiance, reference: &[(f64, f64)]) {
+    let lut = BandLut::new(band);
     let (mut worst_quad, mut worst_lut, mut worst_ln) = ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0));
-    for (t, want) in reference() {
+    for &(t, want) in reference {
         let t32 = t as f32;
-        assert_eq!(f64::from(t32), t, "reference temperatures are f32-exact");
+        if f64::from(t32) != t {
+            // 273.15 K of the measured table: not an f32.
+            continue;
+        }
         let quad = f64::from(band.radiance_f32(t32, 1.0).unwrap());
         let table = f64::from(lut.radiance_f32(t32, 1.0).unwrap());
         if want >= f64::from(f32::MIN_POSITIVE) {
@@ -100,7 +125,7 @@ fn f32_paths_within_1e5_where_l_is_a_normal_f32() {
 fn shared_reference_rows_match() {
     // Independent check against shared/reference/REFERENCE.md §3 (same model, made
     // with another script run), including the two temperatures that are not f32-exact.
-    let band = BandRadiance::hayabusa2_tir();
+    let band = BandRadiance::hayabusa2_tir_bell();
     for (t, want) in [
         (2.7, 5.928_670_475_583_473_5e-162),
         (10.0, 2.428_133_328_200_529_7e-50),
@@ -110,6 +135,59 @@ fn shared_reference_rows_match() {
     ] {
         let got = band.radiance_w_m2_sr(t, 1.0).unwrap();
         assert!(rel(got, want) < 1e-9, "T = {t}: {got} vs {want}");
+    }
+}
+
+#[test]
+fn measured_response_f64_within_1e6_from_50_k_to_2000_k_and_1e9_from_3_k() {
+    let band = BandRadiance::hayabusa2_tir();
+    let (mut worst_band, mut worst_all) = ((0.0, 0.0), (0.0, 0.0));
+    let rows = reference_measured();
+    assert!(rows.len() > 80, "reference table has {} rows", rows.len());
+    for (t, want) in rows {
+        let got = band.radiance_w_m2_sr(t, 1.0).unwrap();
+        if t >= 3.0 {
+            let e = rel(got, want);
+            if e > worst_all.0 {
+                worst_all = (e, t);
+            }
+            if (50.0..=2000.0).contains(&t) && e > worst_band.0 {
+                worst_band = (e, t);
+            }
+        } else if want >= f64::MIN_POSITIVE {
+            // 1.25–3 K: the pile-up against 17.91 um, where the tail panels end
+            // (1.25 K: 4.5e-285 W m^-2 sr^-1, 1.3e-7 relative).
+            assert!(rel(got, want) <= 1e-6, "T = {t}: {got} vs {want}");
+        } else {
+            // 1 K: 6e-354, below the f64 range.
+            assert!((got - want).abs() < 2.3e-308, "T = {t}: {got} vs {want}");
+        }
+    }
+    eprintln!(
+        "measured response, f64: worst relative error {:.2e} at {} K over 50-2000 K, {:.2e} at {} K over 3-5000 K",
+        worst_band.0, worst_band.1, worst_all.0, worst_all.1
+    );
+    // The bound over the camera's temperatures, and a tighter one everywhere.
+    assert!(worst_band.0 <= 1e-6, "worst {worst_band:?}");
+    assert!(worst_all.0 <= 1e-9, "worst {worst_all:?}");
+}
+
+#[test]
+fn measured_response_matches_the_shared_reference_cross_check() {
+    // REFERENCE.md §3: L_meas(300 K) = 29.6172 (5 digits, from the sample sum of the
+    // same file, which differs from the piecewise-linear integral by 4e-7).
+    let l = BandRadiance::hayabusa2_tir()
+        .radiance_w_m2_sr(300.0, 1.0)
+        .unwrap();
+    assert!((l - 29.6172).abs() <= 0.00005 + 29.6172 * 4e-7, "{l}");
+    // … and L_meas/L_model(η = 1) = 0.8867 at 300 K, 0.8895 at 150 K, 0.8849 at 500 K.
+    let bell = BandRadiance::hayabusa2_tir_bell();
+    for (t, want) in [(150.0, 0.8895), (300.0, 0.8867), (500.0, 0.8849)] {
+        let ratio = BandRadiance::hayabusa2_tir()
+            .radiance_w_m2_sr(t, 1.0)
+            .unwrap()
+            / bell.radiance_w_m2_sr(t, 1.0).unwrap();
+        assert!((ratio - want).abs() <= 0.00005 + 1e-6, "T = {t}: {ratio}");
     }
 }
 
@@ -134,30 +212,38 @@ fn flat_response_is_sigma_t4_over_pi() {
 
 #[test]
 fn derivative_matches_central_differences() {
-    let band = BandRadiance::hayabusa2_tir();
-    for t in [20.0, 100.0, 300.0, 1500.0] {
-        let h = t * 1e-5;
-        let fd = (band.radiance_w_m2_sr(t + h, 1.0).unwrap()
-            - band.radiance_w_m2_sr(t - h, 1.0).unwrap())
-            / (2.0 * h);
-        let d = band.radiance_derivative_w_m2_sr_k(t, 1.0).unwrap();
-        assert!(rel(d, fd) < 1e-7, "T = {t}: {d} vs {fd}");
+    for band in [
+        BandRadiance::hayabusa2_tir(),
+        BandRadiance::hayabusa2_tir_bell(),
+    ] {
+        for t in [20.0, 100.0, 300.0, 1500.0] {
+            let h = t * 1e-5;
+            let fd = (band.radiance_w_m2_sr(t + h, 1.0).unwrap()
+                - band.radiance_w_m2_sr(t - h, 1.0).unwrap())
+                / (2.0 * h);
+            let d = band.radiance_derivative_w_m2_sr_k(t, 1.0).unwrap();
+            assert!(rel(d, fd) < 1e-7, "T = {t}: {d} vs {fd}");
+        }
     }
 }
 
 #[test]
 fn inverse_recovers_the_temperature() {
-    let band = BandRadiance::hayabusa2_tir();
-    for t in [5.0, 13.0, 50.0, 150.0, 276.2, 300.0, 460.0, 2000.0, 9000.0] {
-        for eps in [1.0, 0.86, 0.05] {
-            let l = band.radiance_w_m2_sr(t, eps).unwrap();
-            let back = band.temperature_k(l, eps).unwrap();
-            assert!(rel(back, t) < 1e-10, "T = {t}, eps = {eps}: {back}");
+    for band in [
+        BandRadiance::hayabusa2_tir(),
+        BandRadiance::hayabusa2_tir_bell(),
+    ] {
+        for t in [5.0, 13.0, 50.0, 150.0, 276.2, 300.0, 460.0, 2000.0, 9000.0] {
+            for eps in [1.0, 0.86, 0.05] {
+                let l = band.radiance_w_m2_sr(t, eps).unwrap();
+                let back = band.temperature_k(l, eps).unwrap();
+                assert!(rel(back, t) < 1e-10, "T = {t}, eps = {eps}: {back}");
+            }
         }
+        assert_eq!(band.temperature_k(0.0, 1.0), Ok(0.0));
+        assert!(band.temperature_k(f64::NAN, 1.0).is_err());
+        assert!(band.temperature_k(1e30, 1.0).is_err());
     }
-    assert_eq!(band.temperature_k(0.0, 1.0), Ok(0.0));
-    assert!(band.temperature_k(f64::NAN, 1.0).is_err());
-    assert!(band.temperature_k(1e30, 1.0).is_err());
 }
 
 #[test]

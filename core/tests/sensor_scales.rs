@@ -1,5 +1,6 @@
 //! The scale of the paper's detection mode (Eq. 4, Table 5) under the chosen sensing
-//! area ΔA_c, against `shared/reference/REFERENCE.md` §4.
+//! area ΔA_c, against `shared/reference/REFERENCE.md` §4, whose numbers are made with
+//! the analytic bell response (η = 1), so these tests use it too.
 
 use tirroi_core::sensor::dn::EARTH_MAX_FLUX_TABLE5_W_M2;
 use tirroi_core::sensor::flux::{distance_compensation, facet_flux_w_m2};
@@ -22,7 +23,7 @@ fn face_on_flux(radiance: f64, distance_m: f64) -> f64 {
 
 #[test]
 fn earth_maximum_flux_is_of_table5_order() {
-    let band = BandRadiance::hayabusa2_tir();
+    let band = BandRadiance::hayabusa2_tir_bell();
     // Warmest CERES cell: OLR 330 W m⁻² → Eq. 10.
     let t_earth = (330.0 / STEFAN_BOLTZMANN_W_M2_K4).powf(0.25);
     assert!((t_earth - 276.201).abs() < 1e-3);
@@ -44,7 +45,7 @@ fn earth_maximum_flux_is_of_table5_order() {
 #[test]
 fn target_saturates_every_scale() {
     // ε = 0.86 face at 300 K (REFERENCE.md §4 table): 15 m and 440 m.
-    let band = BandRadiance::hayabusa2_tir();
+    let band = BandRadiance::hayabusa2_tir_bell();
     let l = band.radiance_w_m2_sr(300.0, 0.86).unwrap();
     for (d, want) in [
         (15.0, 1.4218e-5),

@@ -64,9 +64,9 @@ fn scene(x: usize, y: usize) -> (f32, f32) {
     }
 }
 
-/// Builds the camera's band radiance (170-node quadrature of ε·B(λ,T)·R(λ)) and its
-/// fast table, once, into the workspace. Never inlined, so that its stack is
-/// measured as its own.
+/// Builds the camera's band radiance (160-node quadrature of ε·B(λ,T)·R(λ) over the
+/// measured Hayabusa2 TIR response) and its fast table, once, into the workspace. Never
+/// inlined, so that its stack is measured as its own.
 #[inline(never)]
 pub fn setup(ws: &mut Workspace<'_>) {
     let tables = &mut *ws.tables;

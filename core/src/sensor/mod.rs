@@ -3,8 +3,10 @@
 //!
 //! Data flows one way through these modules:
 //!
-//! 1. [`response`]: the camera response R(λ) = η·R_L(λ)·R_F(λ) (Eq. 3), an analytic
-//!    skewed-bell band model of the TIR (8–12 µm), or a flat R = 1 for hand checks.
+//! 1. [`response`]: the camera response R(λ) = η·R_L(λ)·R_F(λ) (Eq. 3): by default the
+//!    Hayabusa2 TIR's measured curve (the const table of [`response_table`], linear
+//!    between its 0.01 µm samples, 0 outside 5.01–17.91 µm), or the analytic
+//!    skewed-bell band model (8–12 µm), or a flat R = 1 for hand checks.
 //! 2. [`planck`]: band radiance i(T, ε) = ∫ ε B(λ,T) R(λ) dλ (Eqs. 1, 6) and emissive
 //!    power F(T) = π·i, exact in f64, in f32, and by the fast table of [`band_lut`].
 //! 3. [`flux`]: the view-factor flux q_fc a facet sends onto the sensor (Eqs. 2, 4) and
@@ -28,6 +30,7 @@ pub mod flux;
 pub mod noise;
 pub mod planck;
 pub mod response;
+pub mod response_table;
 pub mod rng;
 
 use core::fmt;
@@ -38,7 +41,7 @@ pub use expose::expose_frame;
 pub use flux::SENSOR_AREA_M2;
 pub use noise::{BolometerParams, NoiseField, NoiseLevel, NoiseSigmas, RmsReading};
 pub use planck::BandRadiance;
-pub use response::{CameraResponse, SkewedBell};
+pub use response::{CameraResponse, SkewedBell, TabulatedResponse};
 
 /// Why a camera-model function refused its input.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,7 +8,12 @@
 //! the response's logistic edges (within a few widths, where R changes fastest), are at
 //! most 1 µm wide elsewhere, and the last 0.3 µm before λ_max is a panel of its own,
 //! because below 10 K the integrand is an exponential that piles up against the long-
-//! wavelength cut. Each node stores c₂/λ and the weight w·R(λ)·c₁/λ⁵, so one radiance
+//! wavelength cut. A tabulated response (the measured Hayabusa2 TIR curve, the default)
+//! gets a product rule instead (16 panels, 160 nodes: equal panels ≤ 1 µm, the last
+//! 2 µm in 0.6 … 0.2 µm panels for the same pile-up): B is interpolated at 10
+//! Gauss–Legendre nodes per panel and the weights W_j = ∫R·ℓ_j dλ are integrated
+//! exactly over every 0.01 µm sample interval, so the kinks of the piecewise-linear R
+//! cost no accuracy. Each node stores c₂/λ and the weight w·R(λ)·c₁/λ⁵, so one radiance
 //! costs one `expm1` per node and no cancellation: B = c₁λ⁻⁵/expm1(c₂/λT).
 //!
 //! # Accuracy (core/tests/sensor_radiance.rs against the 30-digit table)
@@ -19,16 +24,24 @@
 //! | [`BandRadiance::radiance_f32`] (f32) | 13–5000 K | ≤ 1e-5 asserted |
 //! | [`BandLut::radiance_f32`](super::BandLut::radiance_f32) (table) | 13–5000 K | ≤ 1e-5 asserted |
 //!
+//! For the measured response (`core/tests/data/band_radiance_hayabusa2_reference.csv`):
+//! f64 ≤ 1e-6 asserted over 50–2000 K (measured 2.0e-15) and ≤ 1e-9 over 3–5000 K
+//! (measured 9.1e-10, at 3 K); f32 quadrature 4.4e-6 and table 4.0e-6 (≤ 1e-5 asserted)
+//! wherever L is a normal f32 (11 K and up).
+//!
 //! Below those bounds the radiance itself leaves the number format: L < 2.2e-308 (f64
 //! normal minimum) below 1.34 K and L < 1.2e-38 (f32 normal minimum) below 13.0 K, so
 //! the f64 path returns subnormals or 0 with an absolute error under 2.3e-308, and the
 //! f32 paths return subnormals or 0 with an absolute error under 1.2e-38;
 //! [`BandRadiance::ln_radiance_f32`] carries ln L instead, with an absolute error in
 //! ln L below 1e-4 down to 3 K (asserted). No signal that small ever reaches a DN.
-//! Results are finite, ≥ 0, exactly 0 at 0 K, and non-decreasing in T (every node's
-//! term is, and they are summed in a fixed order).
+//! Results are finite, exactly 0 at 0 K, and non-decreasing in T: for the bell every
+//! node's term is, and they are summed in a fixed order. The measured table has noise
+//! below zero in its tail (down to −2.6e-5), so a few of its weights are negative; its f64
+//! path and table are monotone on a dense sweep of 2–5000 K, its f32 quadrature from
+//! 13 K (below, where L < 1e-34, it can fall by 2 ulp; tested in sensor_stability.rs).
 
-use super::response::{CameraResponse, SkewedBell};
+use super::response::{CameraResponse, SkewedBell, TabulatedResponse};
 use super::{SensorError, check_range};
 
 /// First radiation constant for spectral radiance per µm, 2hc² = 1.191 042 972 397 e8
@@ -113,6 +126,7 @@ impl BandRadiance {
                 me.flat_w_m2_sr_k4 = Some(flat_integral() * C1_W_UM4_M2_SR / c2_pow4());
             }
             CameraResponse::Band(bell) => me.fill_band(bell)?,
+            CameraResponse::Tabulated(table) => me.fill_tabulated(table)?,
         }
         Ok(me)
     }
@@ -131,9 +145,20 @@ impl BandRadiance {
         }
     }
 
-    /// The Hayabusa2 TIR model with η = 1 ([`SkewedBell::HAYABUSA2_TIR`]).
+    /// The Hayabusa2 TIR camera: its measured response
+    /// ([`TabulatedResponse::HAYABUSA2_TIR`], the default), 160 nodes.
     pub fn hayabusa2_tir() -> Self {
         match Self::new(&CameraResponse::default()) {
+            Ok(b) => b,
+            // The built-in table validates and needs 16 panels (unit-tested).
+            Err(_) => unreachable_band(),
+        }
+    }
+
+    /// The analytic skewed-bell model of the Hayabusa2 TIR with η = 1
+    /// ([`SkewedBell::HAYABUSA2_TIR`]), 170 nodes.
+    pub fn hayabusa2_tir_bell() -> Self {
+        match Self::new(&CameraResponse::Band(SkewedBell::HAYABUSA2_TIR)) {
             Ok(b) => b,
             // The built-in model validates and needs 17 panels (unit-tested).
             Err(_) => unreachable_band(),
@@ -158,6 +183,82 @@ impl BandRadiance {
                 }
             }
         }
+        self.finish_nodes(k);
+        Ok(())
+    }
+
+    /// Product Gauss–Legendre quadrature of a piecewise-linear table: the band (first
+    /// to last sample) is cut into panels of whole sample intervals ([`table_breaks`]);
+    /// on each panel B(λ, T) is replaced by its degree-9
+    /// interpolant at the 10 Gauss–Legendre nodes λ_j, so ∫R·B dλ ≈ Σ_j W_j·B(λ_j)
+    /// with W_j = ∫R(λ)·ℓ_j(λ) dλ (ℓ_j the Lagrange basis). R·ℓ_j is a polynomial of
+    /// degree 10 on each sample interval, which the 10-point rule integrates exactly,
+    /// so the kinks of R cost nothing; only B's smoothness over a panel sets the error.
+    fn fill_tabulated(&mut self, table: &TabulatedResponse) -> Result<(), SensorError> {
+        table.validate()?;
+        let mut breaks = [0usize; MAX_PANELS + 1];
+        let panels = table_breaks(table, &mut breaks)?;
+        let mut k = 0;
+        for p in breaks[..=panels].windows(2) {
+            let (s0, s1) = (p[0], p[1]);
+            let (a, b) = (table.wavelength_um(s0), table.wavelength_um(s1));
+            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+            let mut lambda = [0.0f64; NODES_PER_PANEL];
+            for (j, &(node, _)) in GAUSS_LEGENDRE_10.iter().enumerate() {
+                lambda[2 * j] = mid - half * node;
+                lambda[2 * j + 1] = mid + half * node;
+            }
+            // Barycentric weights 1/Π_{k≠j}(λ_j − λ_k) of the panel's nodes.
+            let mut inv_denominator = [0.0f64; NODES_PER_PANEL];
+            for (j, d) in inv_denominator.iter_mut().enumerate() {
+                let mut prod = 1.0;
+                for (m, &l) in lambda.iter().enumerate() {
+                    if m != j {
+                        prod *= lambda[j] - l;
+                    }
+                }
+                *d = 1.0 / prod;
+            }
+            let mut w_panel = [0.0f64; NODES_PER_PANEL];
+            for s in s0..s1 {
+                let (r0, r1) = (table.sample(s), table.sample(s + 1));
+                if r0 == 0.0 && r1 == 0.0 {
+                    continue;
+                }
+                let (sa, sb) = (table.wavelength_um(s), table.wavelength_um(s + 1));
+                let (smid, shalf) = (0.5 * (sa + sb), 0.5 * (sb - sa));
+                for &(node, w) in &GAUSS_LEGENDRE_10 {
+                    for sign in [-1.0, 1.0] {
+                        let x = smid + sign * shalf * node;
+                        let t = (x - sa) / (sb - sa);
+                        let r_w = (r0 * (1.0 - t) + r1 * t) * w * shalf;
+                        // ℓ_j(x) = Π_{k≠j}(x − λ_k) / Π_{k≠j}(λ_j − λ_k), from prefix
+                        // and suffix products (no division by x − λ_j).
+                        let mut prefix = [1.0f64; NODES_PER_PANEL];
+                        for m in 1..NODES_PER_PANEL {
+                            prefix[m] = prefix[m - 1] * (x - lambda[m - 1]);
+                        }
+                        let mut suffix = 1.0;
+                        for m in (0..NODES_PER_PANEL).rev() {
+                            w_panel[m] += r_w * prefix[m] * suffix * inv_denominator[m];
+                            suffix *= x - lambda[m];
+                        }
+                    }
+                }
+            }
+            for (&l, &w) in lambda.iter().zip(&w_panel) {
+                let l5 = l * l * l * l * l;
+                self.x_t_k[k] = C2_UM_K / l;
+                self.weight[k] = w * C1_W_UM4_M2_SR / l5;
+                k += 1;
+            }
+        }
+        self.finish_nodes(k);
+        Ok(())
+    }
+
+    /// Records `k` filled nodes and derives the f32 path's arrays from them.
+    fn finish_nodes(&mut self, k: usize) {
         self.nodes = k;
         let x_min = self.x_t_k[..k]
             .iter()
@@ -168,7 +269,6 @@ impl BandRadiance {
             self.dx_t_k32[i] = (self.x_t_k[i] - x_min) as f32;
             self.weight32[i] = self.weight[i] as f32;
         }
-        Ok(())
     }
 
     /// The response this radiance integrates over.
@@ -463,6 +563,58 @@ fn panel_breaks(bell: &SkewedBell, out: &mut [f64; MAX_PANELS + 1]) -> Result<us
     Ok(n)
 }
 
+/// Widths of the last panels of a tabulated response, µm, from its long-wavelength end
+/// backwards: below about 20 K the integrand is an exponential piling up against the end
+/// of the table (d ln B/dλ = c₂/(λ²T) = 15/µm at 17.9 µm and 3 K), so the panels there
+/// shrink to keep B's degree-9 interpolant within 1e-9 (5.9e-9 at 2 K, 9e-10 at 3 K for
+/// the TIR table); 2 µm in all.
+const TABLE_TAIL_PANELS_UM: [f64; 5] = [0.2, 0.3, 0.4, 0.5, 0.6];
+
+/// Panel boundaries of `table` as sample indices into `out`, ascending from 0 to the
+/// last sample; returns the number of panels. The last 2 µm in the panels of
+/// [`TABLE_TAIL_PANELS_UM`], the rest in equal panels of at most [`MAX_PANEL_UM`] (both
+/// rounded to whole sample intervals, at least one each): 16 panels for the TIR table.
+fn table_breaks(
+    table: &TabulatedResponse,
+    out: &mut [usize; MAX_PANELS + 1],
+) -> Result<usize, SensorError> {
+    let too_wide = SensorError::OutOfRange {
+        name: "samples_micro",
+        value: table.last_um() - table.first_um,
+        expected: "a table that fits in 24 quadrature panels (about 20 um)",
+    };
+    let intervals = |width_um: f64| (libm::round(width_um / table.step_um) as usize).max(1);
+    // From the end backwards: the tail panels, as long as the table lasts.
+    let mut tail = [0usize; TABLE_TAIL_PANELS_UM.len()];
+    let mut tail_count = 0;
+    let mut end = table.len() - 1;
+    for &w in &TABLE_TAIL_PANELS_UM {
+        let n = intervals(w);
+        if end <= n {
+            break;
+        }
+        end -= n;
+        tail[tail_count] = end;
+        tail_count += 1;
+    }
+    // [0, end] in equal panels of at most MAX_PANEL_UM.
+    let per_panel = (libm::floor(MAX_PANEL_UM / table.step_um + 1e-9) as usize).max(1);
+    let uniform = end.div_ceil(per_panel);
+    // The tail's first boundary is `end` itself, the last the table's end.
+    let panels = uniform + tail_count;
+    if panels > MAX_PANELS {
+        return Err(too_wide);
+    }
+    for (p, o) in out[..=uniform].iter_mut().enumerate() {
+        *o = p * end / uniform;
+    }
+    for i in 1..tail_count {
+        out[uniform + i] = tail[tail_count - 1 - i];
+    }
+    out[panels] = table.len() - 1;
+    Ok(panels)
+}
+
 /// (c₂)⁴ in (µm K)⁴.
 fn c2_pow4() -> f64 {
     let c2 = C2_UM_K;
@@ -516,9 +668,27 @@ mod tests {
 
     #[test]
     fn tir_model_needs_17_panels() {
-        let b = BandRadiance::hayabusa2_tir();
+        let b = BandRadiance::hayabusa2_tir_bell();
         assert_eq!(b.nodes(), 170);
         assert!(b.flat_w_m2_sr_k4.is_none());
+    }
+
+    #[test]
+    fn measured_table_needs_16_panels() {
+        let b = BandRadiance::hayabusa2_tir();
+        assert_eq!(b.nodes(), 160);
+        let mut breaks = [0usize; MAX_PANELS + 1];
+        let n = table_breaks(&TabulatedResponse::HAYABUSA2_TIR, &mut breaks).unwrap();
+        assert_eq!(n, 16);
+        // 5.01 um + 0.01 um per index: 11 panels of 0.99 um to 15.91 um, then the tail.
+        assert_eq!(
+            breaks[..=n],
+            [
+                0, 99, 198, 297, 396, 495, 594, 693, 792, 891, 990, 1090, 1150, 1200, 1240, 1270,
+                1290
+            ]
+        );
+        assert_eq!(b.response(), CameraResponse::default());
     }
 
     #[test]

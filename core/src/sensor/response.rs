@@ -1,6 +1,14 @@
 //! The camera response R(λ) = η·R_L(λ)·R_F(λ) of paper Eq. 3.
 //!
-//! The paper fits "skewed bell-shaped curves" to the Hayabusa2 TIR data of its ref. \[33\]
+//! The default is the real one: [`TabulatedResponse::HAYABUSA2_TIR`], the response of
+//! JAXA's Hayabusa2 TIR as its team measured it (lens, filter and detector together, so
+//! η is inside the numbers), on a 0.01 µm grid from 5.01 to 17.91 µm, linear between the
+//! samples and 0 outside. The table is generated from `core/data/hayabusa2-tir/response.txt`
+//! (provenance in the NOTICE beside it) into [`response_table`](super::response_table);
+//! its 30-digit band integrals are in `core/tests/data/band_radiance_hayabusa2_reference.csv`,
+//! made by `scripts/reference/band_radiance_hayabusa2.py`.
+//!
+//! The analytic model stays selectable (`CameraResponse::Band`). The paper fits "skewed bell-shaped curves" to the Hayabusa2 TIR data of its ref. \[33\]
 //! (Fig. 1) without printing the numbers. [`SkewedBell::HAYABUSA2_TIR`] adopts the model
 //! of the project's shared reference (`shared/reference/REFERENCE.md`, §3), a rounded
 //! least-squares fit to the measured TIR curve: a logistic rise (the lens and filter
@@ -9,6 +17,7 @@
 //! `core/tests/data/band_radiance_reference.csv`, made by
 //! `scripts/reference/band_radiance.py`.
 
+use super::response_table;
 use super::{SensorError, check_positive, check_range};
 
 /// Analytic skewed-bell band model (λ in µm, σ(z) = 1/(1 + e^(−z))):
@@ -176,10 +185,124 @@ fn logistic(z: f64) -> f64 {
     }
 }
 
+/// A response tabulated on a uniform wavelength grid: sample i is R at
+/// λ_i = `first_um` + i·`step_um`, in millionths (exact for data given to 6 decimals).
+///
+/// Interpolation rule: R is linear in λ between neighbouring samples and 0 outside
+/// [λ_0, λ_last] (a measured response ends in zero samples, so this is continuous).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TabulatedResponse {
+    /// Wavelength of the first sample, µm (≥ 0.1).
+    pub first_um: f64,
+    /// Spacing of the samples, µm (> 0).
+    pub step_um: f64,
+    /// R at each sample, in units of 1e-6 (dimensionless; |R| ≤ 1). At least 2 samples.
+    pub samples_micro: &'static [i32],
+}
+
+/// Millionths per unit of response: the scale of [`TabulatedResponse::samples_micro`].
+const MICRO_PER_UNIT: f64 = 1_000_000.0;
+
+impl TabulatedResponse {
+    /// The measured response of the Hayabusa2 TIR (η included): 1291 samples from
+    /// 5.01 µm to 17.91 µm, step 0.01 µm, peak 0.908740 at 8.85 µm, ∫R dλ = 3.06913 µm.
+    /// Outside the stored span the source file is 0 everywhere, so nothing is cut.
+    pub const HAYABUSA2_TIR: TabulatedResponse = TabulatedResponse {
+        first_um: response_table::FIRST_CENTI_UM as f64 / 100.0,
+        step_um: 0.01,
+        samples_micro: &response_table::RESPONSE_MICRO,
+    };
+
+    /// Checks the grid: `first_um` in [0.1, 1000] µm, `step_um` in (0, 1000] µm, the
+    /// last sample at most 1000 µm, at least 2 samples, every |R| ≤ 1.
+    ///
+    /// # Errors
+    /// [`SensorError`] naming the first bad field.
+    pub fn validate(&self) -> Result<(), SensorError> {
+        check_range("first_um", self.first_um, 0.1, 1000.0, "0.1..=1000 um")?;
+        check_range(
+            "step_um",
+            self.step_um,
+            f64::MIN_POSITIVE,
+            1000.0,
+            "0 < step_um <= 1000 um",
+        )?;
+        if self.samples_micro.len() < 2 {
+            return Err(SensorError::BadSize {
+                name: "samples_micro",
+                actual: self.samples_micro.len(),
+                expected: 2,
+            });
+        }
+        check_range(
+            "samples_micro (last wavelength)",
+            self.last_um(),
+            self.first_um,
+            1000.0,
+            "a last sample at most 1000 um",
+        )?;
+        for &r in self.samples_micro {
+            check_range(
+                "samples_micro",
+                f64::from(r),
+                -MICRO_PER_UNIT,
+                MICRO_PER_UNIT,
+                "|R| <= 1 (1 000 000 millionths)",
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples_micro.len()
+    }
+
+    /// True for a table without samples (never valid).
+    pub fn is_empty(&self) -> bool {
+        self.samples_micro.is_empty()
+    }
+
+    /// R at sample `i`, dimensionless (0 past the end).
+    pub fn sample(&self, i: usize) -> f64 {
+        // An integer over a power of ten: correctly rounded, the same f64 as the
+        // data file's decimal.
+        self.samples_micro
+            .get(i)
+            .map_or(0.0, |&r| f64::from(r) / MICRO_PER_UNIT)
+    }
+
+    /// Wavelength of sample `i`, µm.
+    pub fn wavelength_um(&self, i: usize) -> f64 {
+        self.first_um + i as f64 * self.step_um
+    }
+
+    /// Wavelength of the last sample, µm.
+    pub fn last_um(&self) -> f64 {
+        self.wavelength_um(self.samples_micro.len().saturating_sub(1))
+    }
+
+    /// R(λ), dimensionless, λ in µm: linear between samples, 0 outside the table (and
+    /// for NaN).
+    pub fn at(&self, lambda_um: f64) -> f64 {
+        let n = self.samples_micro.len();
+        let u = (lambda_um - self.first_um) / self.step_um;
+        if n < 2 || !(u >= 0.0 && u <= (n - 1) as f64) {
+            return 0.0;
+        }
+        let i = (u as usize).min(n - 2);
+        let t = u - i as f64;
+        self.sample(i) * (1.0 - t) + self.sample(i + 1) * t
+    }
+}
+
 /// Which spectral response the camera model integrates over.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CameraResponse {
-    /// The band model of the TIR (the default).
+    /// A measured response on a wavelength grid (the default: the Hayabusa2 TIR's,
+    /// [`TabulatedResponse::HAYABUSA2_TIR`]; `tirroi sensor --response hayabusa2`).
+    Tabulated(TabulatedResponse),
+    /// The analytic band model ([`SkewedBell::HAYABUSA2_TIR`]: `--response tir`).
     Band(SkewedBell),
     /// R(λ) = 1 at every wavelength: the band radiance becomes ε·σT⁴/π, a check anyone
     /// can do by hand (`tirroi sensor --response flat`).
@@ -187,16 +310,19 @@ pub enum CameraResponse {
 }
 
 impl Default for CameraResponse {
+    /// The measured Hayabusa2 TIR response.
     fn default() -> Self {
-        CameraResponse::Band(SkewedBell::HAYABUSA2_TIR)
+        CameraResponse::Tabulated(TabulatedResponse::HAYABUSA2_TIR)
     }
 }
 
 impl CameraResponse {
-    /// R(λ), dimensionless, λ in µm: 0 outside the band (and for NaN), η at the peak.
+    /// R(λ), dimensionless, λ in µm: 0 outside the band (and for NaN); η at the peak of
+    /// the bell, 0.90874 at the peak of the measured table.
     pub fn at(&self, lambda_um: f64) -> f64 {
         match self {
             CameraResponse::Flat => 1.0,
+            CameraResponse::Tabulated(t) => t.at(lambda_um),
             CameraResponse::Band(b) => {
                 if !(lambda_um >= b.band_min_um && lambda_um <= b.band_max_um) {
                     return 0.0;
@@ -226,6 +352,35 @@ mod tests {
         assert_eq!(r.at(16.01), 0.0);
         assert_eq!(r.at(f64::NAN), 0.0);
         assert!((r.at(l_pk) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn measured_table_interpolates_linearly_and_is_zero_outside() {
+        let t = TabulatedResponse::HAYABUSA2_TIR;
+        assert!(t.validate().is_ok());
+        assert_eq!(t.len(), 1291);
+        let r = CameraResponse::default();
+        // Samples of the data file: 8.85 um 0.908740 (the peak), 8.86 um 0.907822.
+        assert!((r.at(8.85) - 0.90874).abs() < 1e-12);
+        assert!((r.at(8.855) - 0.5 * (0.90874 + 0.907822)).abs() < 1e-12);
+        assert_eq!(r.at(5.0), 0.0);
+        assert_eq!(r.at(17.92), 0.0);
+        assert_eq!(r.at(f64::NAN), 0.0);
+        let peak = (0..t.len()).map(|i| t.sample(i)).fold(0.0, f64::max);
+        assert_eq!(peak, 0.90874);
+        let bad = TabulatedResponse {
+            samples_micro: &[0],
+            ..t
+        };
+        assert!(matches!(
+            bad.validate(),
+            Err(SensorError::BadSize {
+                name: "samples_micro",
+                ..
+            })
+        ));
+        let bad = TabulatedResponse { step_um: 0.0, ..t };
+        assert!(bad.validate().is_err());
     }
 
     #[test]

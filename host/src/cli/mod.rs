@@ -78,7 +78,7 @@ pub enum Command {
     /// Bad input prints one line `tirroi: error: ...` and exits with code 2.
     ///
     /// With --json, one JSON object on stdout:
-    ///   {"response":"tir"|"flat", "level":"netd"|"paper-literal"|"paper-visible",
+    ///   {"response":"hayabusa2"|"tir"|"flat", "level":"netd"|"paper-literal"|"paper-visible",
     ///    "netd_k":0.4, "t_ref_k":300, "bits":14, "emissivity":1,
     ///    "mapping":{"t_lo_k","t_hi_k","f_min_w_m2","f_max_w_m2","gain_dn_per_w_m2",
     ///               "offset_dn","max_dn"},

@@ -73,7 +73,9 @@ impl Library {
     /// # Errors
     /// [`DatasetError`] when an Earth source cannot be read or a thermal solve fails.
     pub fn build(file: &SceneFile, plans: &[ImagePlan]) -> Result<Library, DatasetError> {
-        let band = BandRadiance::hayabusa2_tir();
+        let response = file.camera.response;
+        let band = BandRadiance::new(&response.to_core())
+            .map_err(|e| DatasetError(format!("camera.response = \"{}\": {e}", response.name())))?;
         let lut = BandLut::new(&band);
         let t0 = Instant::now();
         let mut mesh_keys: Vec<_> = plans.iter().map(|p| p.thermal.mesh_key()).collect();

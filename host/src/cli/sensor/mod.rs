@@ -93,9 +93,10 @@ pub struct SensorArgs {
         allow_hyphen_values = true
     )]
     pub bandwidths: String,
-    /// Spectral response: tir (the Hayabusa2 TIR band model, 8-12 um) or flat (R = 1, so
+    /// Spectral response: hayabusa2 (the Hayabusa2 TIR's measured curve, the default),
+    /// tir (the analytic skewed-bell model of it, 8-12 um, eta = 1) or flat (R = 1, so
     /// that i = emissivity x sigma T^4/pi (W m^-2 sr^-1)).
-    #[arg(long, value_name = "RESPONSE", default_value = "tir")]
+    #[arg(long, value_name = "RESPONSE", default_value = "hayabusa2")]
     pub response: String,
     /// Print one JSON object (shape in `tirroi sensor --help`) instead of the tables.
     #[arg(long)]

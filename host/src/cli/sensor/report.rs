@@ -13,6 +13,8 @@ use tirroi_core::sensor::{
     SensorError,
 };
 
+use crate::world::scene::ResponseName;
+
 /// Which noise level sets the σ in DN (`tirroi_core::sensor::NoiseLevel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -84,7 +86,13 @@ impl ReadingChoice {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ResponseChoice {
-    /// The Hayabusa2 TIR band model, 8–12 µm (`CameraResponse::default()`).
+    /// The Hayabusa2 TIR's measured response (`CameraResponse::default()`; JAXA's TIR
+    /// team, 0.01 µm samples, linear between them).
+    #[value(name = "hayabusa2")]
+    #[serde(rename = "hayabusa2")]
+    Hayabusa2,
+    /// The analytic skewed-bell model of the TIR, 8–12 µm, η = 1
+    /// (`SkewedBell::HAYABUSA2_TIR`).
     Tir,
     /// R = 1 at every wavelength: i = ε·σT⁴/π, checkable by hand.
     Flat,
@@ -93,18 +101,21 @@ pub enum ResponseChoice {
 impl ResponseChoice {
     /// The name used on the command line and in the JSON.
     pub fn name(self) -> &'static str {
+        self.scene_name().name()
+    }
+
+    /// The same choice as a scene file's `[camera] response`.
+    pub fn scene_name(self) -> ResponseName {
         match self {
-            Self::Tir => "tir",
-            Self::Flat => "flat",
+            Self::Hayabusa2 => ResponseName::Hayabusa2,
+            Self::Tir => ResponseName::Tir,
+            Self::Flat => ResponseName::Flat,
         }
     }
 
     /// The core's response.
     pub fn to_core(self) -> CameraResponse {
-        match self {
-            Self::Tir => CameraResponse::default(),
-            Self::Flat => CameraResponse::Flat,
-        }
+        self.scene_name().to_core()
     }
 }
 
@@ -116,7 +127,7 @@ pub struct SensorRequest<'a> {
     pub level: &'a str,
     /// `--reading`: `table2`, `as-printed` or `physical`.
     pub reading: &'a str,
-    /// `--response`: `tir` or `flat`.
+    /// `--response`: `hayabusa2`, `tir` or `flat`.
     pub response: &'a str,
     /// `--netd-k`: NETD, K.
     pub netd_k: &'a str,

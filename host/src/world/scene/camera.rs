@@ -4,6 +4,43 @@ use serde::{Deserialize, Serialize};
 use tirroi_core::capacity::{Cap1024x768, FrameCapacity};
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::sensor::noise::{DEFAULT_FLICKER_CORRELATION_PX, TIR_NETD_K};
+use tirroi_core::sensor::{CameraResponse, SkewedBell};
+
+/// The spectral response R(λ) the camera integrates the scene's radiance over
+/// (`[camera] response = "hayabusa2" | "tir" | "flat"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ResponseName {
+    /// The Hayabusa2 TIR's measured response (JAXA's Hayabusa2 TIR team; the default):
+    /// `CameraResponse::default()`.
+    #[default]
+    Hayabusa2,
+    /// The analytic skewed-bell model of the same camera, η = 1
+    /// (`SkewedBell::HAYABUSA2_TIR`): about 13 % more radiance than the real curve.
+    Tir,
+    /// R = 1 at every wavelength: the radiance is ε·σT⁴/π.
+    Flat,
+}
+
+impl ResponseName {
+    /// The name in a scene file and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hayabusa2 => "hayabusa2",
+            Self::Tir => "tir",
+            Self::Flat => "flat",
+        }
+    }
+
+    /// The core's response.
+    pub fn to_core(self) -> CameraResponse {
+        match self {
+            Self::Hayabusa2 => CameraResponse::default(),
+            Self::Tir => CameraResponse::Band(SkewedBell::HAYABUSA2_TIR),
+            Self::Flat => CameraResponse::Flat,
+        }
+    }
+}
 
 /// The camera of Table 4 (Hayabusa2 TIR) and its read-out.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -26,6 +63,9 @@ pub struct Camera {
     pub netd_reference_k: f64,
     /// Correlation length of the 1/f noise map, pixels (4).
     pub flicker_correlation_px: f32,
+    /// Spectral response: "hayabusa2" (the measured curve, default), "tir" (the
+    /// analytic bell) or "flat".
+    pub response: ResponseName,
 }
 
 impl Default for Camera {
@@ -39,6 +79,7 @@ impl Default for Camera {
             netd_k: TIR_NETD_K,
             netd_reference_k: 300.0,
             flicker_correlation_px: DEFAULT_FLICKER_CORRELATION_PX,
+            response: ResponseName::Hayabusa2,
         }
     }
 }

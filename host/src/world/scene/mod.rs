@@ -41,7 +41,7 @@ mod spec;
 #[cfg(test)]
 mod tests;
 
-pub use camera::Camera;
+pub use camera::{Camera, ResponseName};
 pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel};
 pub use spec::{DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION, SceneSpec};
 

@@ -65,3 +65,26 @@ fn errors_name_line_and_field() {
     );
     assert!(SceneFile::parse("", "x").is_err());
 }
+
+#[test]
+fn camera_response_is_hayabusa2_by_default_and_selectable() {
+    use tirroi_core::sensor::{CameraResponse, SkewedBell};
+    let scene = "[[scene]]\nrange_m = 20.0\n";
+    let f = SceneFile::parse(scene, "x").unwrap();
+    assert_eq!(f.camera.response, ResponseName::Hayabusa2);
+    assert_eq!(f.camera.response.to_core(), CameraResponse::default());
+    for (name, want) in [
+        ("hayabusa2", CameraResponse::default()),
+        ("tir", CameraResponse::Band(SkewedBell::HAYABUSA2_TIR)),
+        ("flat", CameraResponse::Flat),
+    ] {
+        let text = format!("[camera]\nresponse = \"{name}\"\n{scene}");
+        let f = SceneFile::parse(&text, "x").unwrap();
+        assert_eq!(f.camera.response.name(), name);
+        assert_eq!(f.camera.response.to_core(), want);
+    }
+    let e =
+        SceneFile::parse(&format!("[camera]\nresponse = \"box\"\n{scene}"), "x.toml").unwrap_err();
+    assert!(e.to_string().contains("x.toml:2:"), "{e}");
+    assert!(e.to_string().contains("hayabusa2"), "{e}");
+}
