@@ -60,13 +60,22 @@ use crate::world::geom::{Vec3, dot, normalize};
 mod error;
 mod illumination;
 mod network;
+mod orbit;
 mod solver;
 #[cfg(test)]
 mod tests;
+mod transient;
+#[cfg(test)]
+mod transient_tests;
 
 pub use error::ThermalError;
 pub use illumination::earth_view_factor;
+pub use orbit::{EARTH_MU_M3_S2, Orbit, OrbitGeometry};
 pub use solver::ThermalSolution;
+pub use transient::{
+    MAX_ORBITS, OrbitState, PERIODIC_TOLERANCE_K, PeriodicOrbit, StepBalance, TRANSIENT_STEP_S,
+    facet_heat_capacities_j_k,
+};
 
 use illumination::Bvh;
 
