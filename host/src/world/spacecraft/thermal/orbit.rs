@@ -80,7 +80,7 @@ impl Orbit {
         if !(self.radius_m.is_finite() && self.radius_m > self.earth_radius_m) {
             return bad("radius not finite or not above the Earth radius");
         }
-        if !(self.beta_rad.abs() <= std::f64::consts::FRAC_PI_2) {
+        if !(-std::f64::consts::FRAC_PI_2..=std::f64::consts::FRAC_PI_2).contains(&self.beta_rad) {
             return bad("beta outside −π/2..=π/2");
         }
         Ok(*self)

@@ -159,7 +159,7 @@ impl ThermalNetwork {
                     capacity_j_k[i]
                 ));
             }
-            if !(temp[i].is_finite() && temp[i] > 0.0) || !absorbed_w[i].is_finite() {
+            if !(temp[i].is_finite() && temp[i] > 0.0 && absorbed_w[i].is_finite()) {
                 return bad(format!(
                     "facet {i}: temperature {} K or absorbed power {} W not finite and positive",
                     temp[i], absorbed_w[i]
