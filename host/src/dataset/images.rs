@@ -61,6 +61,15 @@ pub struct ImageRecord {
     pub noise_seed: Option<u64>,
     /// Coldest and hottest target facet, K.
     pub target_temperature_k: [f64; 2],
+    /// Transient thermal state (`dataset.thermal = "transient"`): time since the
+    /// target entered the Earth's shadow, s (0..orbital period; in eclipse while below
+    /// `eclipse_duration_s`, sunlit after it); absent for steady states.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit_time_s: Option<f64>,
+    /// Transient thermal state: the orbit's time in shadow, s (2 249 s on the reference
+    /// orbit); absent for steady states.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eclipse_duration_s: Option<f64>,
     /// Dataset seed.
     pub dataset_seed: u64,
 }
@@ -124,6 +133,8 @@ fn record(
         noise_sigma_dn: frame.noise_sigma_dn,
         noise_seed: plan.noise_seed,
         target_temperature_k: [thermal.min_max_k.0, thermal.min_max_k.1],
+        orbit_time_s: thermal.orbit_time_s,
+        eclipse_duration_s: thermal.eclipse_duration_s,
         dataset_seed: file.dataset.seed,
     }
 }

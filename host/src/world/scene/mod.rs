@@ -36,7 +36,7 @@ mod spec;
 mod tests;
 
 pub use camera::Camera;
-pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
+pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel, ThermalModel};
 pub use spec::{DatasetSettings, EarthModel, EarthSource, SceneSpec};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
@@ -244,6 +244,7 @@ fn explain(message: &str, key: Option<&str>) -> String {
         "illumination" => Some("\"sunlit\", \"eclipse\", or a list of them"),
         "scale" => Some("1, 2, 3, or a list of them"),
         "source" => Some("\"builtin\" or \"netcdf\""),
+        "thermal" => Some("\"steady\" or \"transient\""),
         _ => None,
     };
     match accepted {

@@ -333,3 +333,73 @@ fn cube_cylinder_orbit_is_periodic_and_cools_in_eclipse() {
         );
     }
 }
+
+/// The figures of the report (run with `cargo test --release -p tirroi-host --lib
+/// transient_report -- --ignored --nocapture`): facet temperature ranges of the
+/// cube + cylinder (Table 3 cases) and Tango at 0.05 m in eclipse at 0, 10, 20, 35 min
+/// after entry and along the sunlit arc, the steady eclipse state for comparison
+/// (Earth at body −z, as on the orbit), and the cost of one periodic orbit.
+#[test]
+#[ignore = "prints the report's figures; slow in debug"]
+fn transient_report() {
+    use crate::world::earth::ECLIPSE_FLUX_FACTOR;
+    use crate::world::spacecraft::models::tango;
+    let orbit = Orbit::reference();
+    let (p, e) = (orbit.period_s(), orbit.eclipse_duration_s());
+    println!("period {p:.1} s, eclipse {e:.1} s ({:.1} %)", 100.0 * e / p);
+    let mut times = vec![0.0, 600.0, 1200.0, 2100.0];
+    let sunlit: Vec<f64> = (0..4)
+        .map(|k| e + (k as f64 + 0.5) / 4.0 * (p - e))
+        .collect();
+    times.extend(&sunlit);
+    let eclipse_olr = EARTH_OLR_W_M2 * f64::from(ECLIPSE_FLUX_FACTOR);
+    let cases: Vec<(String, Mesh)> = MaterialCase::ALL
+        .iter()
+        .map(|&c| {
+            (
+                format!("cube-cylinder {}", c.label()),
+                cube_cylinder(c, 0.05),
+            )
+        })
+        .chain([("tango".to_string(), tango(0.05))])
+        .collect();
+    for (name, mesh) in &cases {
+        let t0 = std::time::Instant::now();
+        let net = ThermalNetwork::new(mesh).unwrap();
+        let cap = facet_heat_capacities_j_k(mesh);
+        let env = ThermalEnvironment::eclipse([0.0, 0.0, -1.0]);
+        let sol = net
+            .periodic_orbit(&cap, &orbit, &env, eclipse_olr, TRANSIENT_STEP_S, &times)
+            .unwrap();
+        let secs = t0.elapsed().as_secs_f64();
+        let mut steady_env = env;
+        steady_env.earth_olr_w_m2 = eclipse_olr;
+        let steady = net.solve(&steady_env).unwrap().min_max_k();
+        println!(
+            "{name}: {} facets, {} orbits, {} steps/orbit, last change {:.3} K, balance {:.1e}, {secs:.2} s; steady eclipse {:.1}–{:.1} K",
+            mesh.facet_count(),
+            sol.orbits,
+            sol.steps_per_orbit,
+            sol.change_k,
+            sol.max_balance_error_rel,
+            steady.0,
+            steady.1
+        );
+        for s in &sol.states {
+            let (lo, hi) = s
+                .temperature_k
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                    (a.min(t), b.max(t))
+                });
+            let mean = s.temperature_k.iter().sum::<f64>() / s.temperature_k.len() as f64;
+            let t = s.geometry.time_s;
+            let label = if s.geometry.sun_dir_body.is_some() {
+                format!("sunlit, {:.0} min after sunrise", (t - e) / 60.0)
+            } else {
+                format!("eclipse, {:.0} min after entry", t / 60.0)
+            };
+            println!("  {label:32} {lo:6.1}–{hi:6.1} K (mean {mean:.1} K)");
+        }
+    }
+}
