@@ -64,7 +64,7 @@ pub struct ThermalKey {
     pub sun_body_bits: [u64; 3],
     /// Earth direction in the body frame (bits).
     pub earth_body_bits: [u64; 3],
-    /// Transient state: time since eclipse entry on [`thermal_orbit`], s (bits);
+    /// Transient state: time since eclipse entry on the dataset's orbit, s (bits);
     /// `None`: the steady state.
     pub orbit_time_bits: Option<u64>,
 }
