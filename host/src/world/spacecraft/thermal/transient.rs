@@ -111,6 +111,8 @@ pub struct PeriodicOrbit {
     pub change_k: f64,
     /// Largest [`StepBalance::error_rel`] of the last orbit.
     pub max_balance_error_rel: f64,
+    /// Newton steps of the last orbit (all its time steps).
+    pub newton_iterations: usize,
     /// The states at the asked times, in their order.
     pub states: Vec<OrbitState>,
 }
@@ -128,6 +130,20 @@ impl ThermalNetwork {
     pub fn step(
         &self,
         temp: &mut [f64],
+        capacity_j_k: &[f64],
+        absorbed_w: &[f64],
+        deep_space_k: f64,
+        dt_s: f64,
+    ) -> Result<StepBalance, ThermalError> {
+        self.step_from(temp, None, capacity_j_k, absorbed_w, deep_space_k, dt_s)
+    }
+
+    /// [`ThermalNetwork::step`] with Newton's method started at `guess` (e.g. the
+    /// linear extrapolation of the last two steps) instead of Tⁿ.
+    fn step_from(
+        &self,
+        temp: &mut [f64],
+        guess: Option<&[f64]>,
         capacity_j_k: &[f64],
         absorbed_w: &[f64],
         deep_space_k: f64,
@@ -174,6 +190,13 @@ impl ThermalNetwork {
             .collect();
         let c_dt: Vec<f64> = capacity_j_k.iter().map(|c| c / dt_s).collect();
         let old = temp.to_vec();
+        if let Some(g) = guess.filter(|g| g.len() == n) {
+            for i in (0..n).filter(|&i| !self.pinned[i]) {
+                if g[i].is_finite() {
+                    temp[i] = g[i].max(ts);
+                }
+            }
+        }
         let scale: f64 = (0..n)
             .filter(|&i| !self.pinned[i])
             .map(|i| input[i].abs() + rad[i] * old[i].powi(4))
@@ -293,9 +316,19 @@ impl ThermalNetwork {
             }
             e
         };
+        // Eclipse steps all see the same Earth (fixed in the body frame) and no Sun:
+        // one absorbed vector serves them all.
+        let dark = self.absorbed_w(&geometry_env(0.0))?;
         let absorbed: Vec<Vec<f64>> = (0..steps)
             .into_par_iter()
-            .map(|j| self.absorbed_w(&geometry_env(0.5 * (grid[j] + grid[j + 1]))))
+            .map(|j| {
+                let env_j = geometry_env(0.5 * (grid[j] + grid[j + 1]));
+                if env_j.sun_dir_body.is_none() {
+                    Ok(dark.clone())
+                } else {
+                    self.absorbed_w(&env_j)
+                }
+            })
             .collect::<Result<_, _>>()?;
         let n = self.facet_count();
         let mut mean = vec![0.0; n];
@@ -320,21 +353,32 @@ impl ThermalNetwork {
             .collect();
         let mut sampled: Vec<Vec<f64>> = vec![Vec::new(); placed.len()];
         let mut prev_change: Option<Vec<f64>> = None;
+        let mut guess = vec![0.0; n];
+        let mut last = temp.clone();
+        let mut last_dt = 1.0;
+        let mut newton_iterations;
         let mut orbit_count = 0;
         loop {
             orbit_count += 1;
             let start = temp.clone();
+            // No predictor across the extrapolation jump.
+            last.copy_from_slice(&temp);
             let mut max_err = 0.0_f64;
+            newton_iterations = 0;
             for j in 0..steps {
-                let before = placed.iter().any(|p| p.0 == j).then(|| temp.clone());
-                let bal = self.step(
-                    &mut temp,
-                    capacity_j_k,
-                    &absorbed[j],
-                    ts,
-                    grid[j + 1] - grid[j],
-                )?;
+                let before = temp.clone();
+                let dt = grid[j + 1] - grid[j];
+                // Predictor: the last step's change, scaled to this step.
+                for i in 0..n {
+                    guess[i] = temp[i] + (temp[i] - last[i]) * dt / last_dt;
+                }
+                let bal =
+                    self.step_from(&mut temp, Some(&guess), capacity_j_k, &absorbed[j], ts, dt)?;
+                newton_iterations += bal.newton_iterations;
                 max_err = max_err.max(bal.error_rel());
+                last.copy_from_slice(&before);
+                last_dt = dt;
+                let before = placed.iter().any(|p| p.0 == j).then_some(before);
                 if let Some(before) = before {
                     for (k, &(pj, w, _)) in placed.iter().enumerate() {
                         if pj == j {
@@ -357,6 +401,7 @@ impl ThermalNetwork {
                     orbits: orbit_count,
                     change_k,
                     max_balance_error_rel: max_err,
+                    newton_iterations,
                     states: placed
                         .iter()
                         .zip(sampled)

@@ -376,10 +376,11 @@ fn transient_report() {
         steady_env.earth_olr_w_m2 = eclipse_olr;
         let steady = net.solve(&steady_env).unwrap().min_max_k();
         println!(
-            "{name}: {} facets, {} orbits, {} steps/orbit, last change {:.3} K, balance {:.1e}, {secs:.2} s; steady eclipse {:.1}–{:.1} K",
+            "{name}: {} facets, {} orbits, {} steps/orbit, {} Newton steps in the last, last change {:.3} K, balance {:.1e}, {secs:.2} s; steady eclipse {:.1}–{:.1} K",
             mesh.facet_count(),
             sol.orbits,
             sol.steps_per_orbit,
+            sol.newton_iterations,
             sol.change_k,
             sol.max_balance_error_rel,
             steady.0,
