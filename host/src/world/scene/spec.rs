@@ -103,7 +103,8 @@ pub struct DatasetSettings {
     /// Master seed: every image's pose, Earth and noise derive from it and its index.
     pub seed: u64,
     /// Thermal states per (target, material, illumination): random-attitude images
-    /// pick one of these steady-state solutions and a camera view consistent with it.
+    /// pick one of these solutions (steady states, or times along the orbit with
+    /// `thermal = "transient"`) and a camera view consistent with it.
     pub thermal_states: usize,
     /// Target temperatures: `"steady"` (default) or `"transient"` (the periodic
     /// state on the orbit, sampled at times along it; random-attitude scenes only,
