@@ -81,6 +81,15 @@ pub struct ImageRecord {
     pub moon_dir_camera: Option<Vec3>,
     /// Coldest and hottest target facet, K.
     pub target_temperature_k: [f64; 2],
+    /// Transient thermal state (`dataset.thermal = "transient"`): time since the
+    /// target entered the Earth's shadow, s (0..orbital period; in eclipse while below
+    /// `eclipse_duration_s`, sunlit after it); absent for steady states.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit_time_s: Option<f64>,
+    /// Transient thermal state: the orbit's time in shadow, s (2 249 s on the reference
+    /// orbit); absent for steady states.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eclipse_duration_s: Option<f64>,
     /// Dataset seed.
     pub dataset_seed: u64,
 }
@@ -158,6 +167,8 @@ fn record(
         moon_px: frame.moon_px,
         moon_dir_camera: plan.moon.map(|m| m.dir_camera),
         target_temperature_k: [thermal.min_max_k.0, thermal.min_max_k.1],
+        orbit_time_s: thermal.orbit_time_s,
+        eclipse_duration_s: thermal.eclipse_duration_s,
         dataset_seed: file.dataset.seed,
     }
 }

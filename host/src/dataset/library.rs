@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
 
 use super::DatasetError;
-use super::plan::{ImagePlan, ThermalKey};
+use super::plan::{ImagePlan, ThermalKey, thermal_orbit};
 use crate::imaging::render::{
     self, EarthView, MoonView, Readout, RenderInput, Rendered, TargetView,
 };
@@ -18,8 +18,10 @@ use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::earth::{EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
 use crate::world::scene::{Camera, EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::spacecraft::thermal::{TRANSIENT_STEP_S, facet_heat_capacities_j_k};
 use crate::world::spacecraft::{
-    MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
+    MaterialCase, Mesh, ThermalEnvironment, ThermalNetwork, cube_cylinder, solve_steady_state,
+    tango,
 };
 
 /// A thermal solution with the numbers the labels report.
@@ -29,6 +31,10 @@ pub struct ThermalState {
     pub temperature_k: Vec<f64>,
     /// Coldest and hottest facet, K.
     pub min_max_k: (f64, f64),
+    /// Transient state: time since eclipse entry on the orbit, s (`None`: steady).
+    pub orbit_time_s: Option<f64>,
+    /// Transient state: the orbit's time in shadow, s (`None`: steady).
+    pub eclipse_duration_s: Option<f64>,
 }
 
 /// Shared, precomputed pieces of a dataset.
@@ -142,9 +148,13 @@ impl Library {
                 k.illumination.label(),
                 k.sun_body_bits,
                 k.earth_body_bits,
+                k.orbit_time_bits,
             )
         });
         thermal_keys.dedup();
+        let (transient_keys, thermal_keys): (Vec<ThermalKey>, Vec<ThermalKey>) = thermal_keys
+            .into_iter()
+            .partition(|k| k.orbit_time_bits.is_some());
         let radius_m = file.earth_model.radius_km * 1e3;
         let distance_m = plans
             .first()
@@ -180,10 +190,83 @@ impl Library {
                     Arc::new(ThermalState {
                         temperature_k: sol.temperature_k,
                         min_max_k,
+                        orbit_time_s: None,
+                        eclipse_duration_s: None,
                     }),
                 ))
             })
             .collect::<Result<_, DatasetError>>()?;
+        let mut thermal = thermal;
+        // Transient states: one periodic orbit per mesh, sampled at every time asked.
+        let mut groups: BTreeMap<(&'static str, &'static str, u64), Vec<ThermalKey>> =
+            BTreeMap::new();
+        for key in transient_keys {
+            groups
+                .entry((
+                    key.target.label(),
+                    key.material.label(),
+                    key.resolution_bits,
+                ))
+                .or_default()
+                .push(key);
+        }
+        let orbit = thermal_orbit(file);
+        let transient: Vec<Vec<(ThermalKey, Arc<ThermalState>)>> = groups
+            .into_values()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|keys| {
+                let key0 = keys[0];
+                let mesh = &meshes[&key0.mesh_key()];
+                let what = || {
+                    format!(
+                        "transient thermal state of {} ({})",
+                        key0.target.label(),
+                        key0.material.label()
+                    )
+                };
+                let net = ThermalNetwork::new(mesh)
+                    .map_err(|e| DatasetError(format!("{}: {e}", what())))?;
+                let capacity = facet_heat_capacities_j_k(mesh);
+                let mut env = ThermalEnvironment::eclipse([0.0, 0.0, -1.0]);
+                env.earth_radius_m = radius_m;
+                env.earth_distance_m = distance_m;
+                env.earth_olr_w_m2 = olr_mean;
+                let times: Vec<f64> = keys.iter().filter_map(|k| k.orbit_time_s()).collect();
+                let sol = net
+                    .periodic_orbit(
+                        &capacity,
+                        &orbit,
+                        &env,
+                        olr_mean * f64::from(factor),
+                        TRANSIENT_STEP_S,
+                        &times,
+                    )
+                    .map_err(|e| DatasetError(format!("{}: {e}", what())))?;
+                Ok(keys
+                    .iter()
+                    .zip(sol.states)
+                    .map(|(k, state)| {
+                        let min_max_k = state
+                            .temperature_k
+                            .iter()
+                            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+                                (lo.min(t), hi.max(t))
+                            });
+                        (
+                            *k,
+                            Arc::new(ThermalState {
+                                temperature_k: state.temperature_k,
+                                min_max_k,
+                                orbit_time_s: Some(state.geometry.time_s),
+                                eclipse_duration_s: Some(sol.eclipse_duration_s),
+                            }),
+                        )
+                    })
+                    .collect())
+            })
+            .collect::<Result<_, DatasetError>>()?;
+        thermal.extend(transient.into_iter().flatten());
         let t3 = Instant::now();
         Ok(Library {
             band,

@@ -5,9 +5,11 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use crate::seed::splitmix64;
+use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::geom::{Rotation, Vec3, normalize, scale};
-use crate::world::scene::{Illumination, Mode, SceneFile, TargetModel};
+use crate::world::scene::{Illumination, Mode, SceneFile, TargetModel, ThermalModel};
 use crate::world::spacecraft::MaterialCase;
+use crate::world::spacecraft::thermal::Orbit;
 
 /// Everything that fixes one image.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,6 +115,9 @@ pub struct ThermalKey {
     pub sun_body_bits: [u64; 3],
     /// Earth direction in the body frame (bits).
     pub earth_body_bits: [u64; 3],
+    /// Transient state: time since eclipse entry on the dataset's orbit, s (bits);
+    /// `None`: the steady state.
+    pub orbit_time_bits: Option<u64>,
 }
 
 impl ThermalKey {
@@ -131,6 +136,37 @@ impl ThermalKey {
 
     pub(super) fn earth_body(&self) -> Vec3 {
         self.earth_body_bits.map(f64::from_bits)
+    }
+
+    /// Time since eclipse entry of a transient state, s (`None`: steady state).
+    pub fn orbit_time_s(&self) -> Option<f64> {
+        self.orbit_time_bits.map(f64::from_bits)
+    }
+}
+
+/// The orbit of a file's transient thermal states: circular at the first scene's
+/// camera–Earth distance (the distance the library's view factors use, 10 871 km by
+/// default), the file's Earth radius, the Sun in the orbit plane (β = 0).
+pub fn thermal_orbit(file: &SceneFile) -> Orbit {
+    Orbit {
+        radius_m: file
+            .scenes
+            .first()
+            .map_or(EARTH_DISTANCE_M, |s| s.earth_distance_km * 1e3),
+        earth_radius_m: file.earth_model.radius_km * 1e3,
+        beta_rad: 0.0,
+    }
+}
+
+/// Time since eclipse entry of transient state `k` of `states`: eclipse states spread
+/// evenly over the shadow, (k + ½)/states × its duration; sunlit ones over the sunlit
+/// arc after it.
+fn orbit_state_time_s(orbit: &Orbit, illumination: Illumination, k: usize, states: usize) -> f64 {
+    let (p, e) = (orbit.period_s(), orbit.eclipse_duration_s());
+    let f = (k as f64 + 0.5) / states.max(1) as f64;
+    match illumination {
+        Illumination::Eclipse => f * e,
+        Illumination::Sunlit => e + f * (p - e),
     }
 }
 
@@ -172,6 +208,8 @@ fn pool_state(
 pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
     let seed = file.dataset.seed;
     let radius_m = file.earth_model.radius_km * 1e3;
+    let orbit = thermal_orbit(file);
+    let transient = file.dataset.thermal == ThermalModel::Transient;
     let mut plans = Vec::with_capacity(file.image_count());
     for (si, spec) in file.scenes.iter().enumerate() {
         let scales: Vec<Option<u8>> = match spec.mode {
@@ -219,6 +257,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 .to_radians();
             let az = spec.earth_azimuth_deg.sample(rng.r#gen()).to_radians();
             let earth_dir_camera = [off.sin() * az.cos(), off.sin() * az.sin(), off.cos()];
+            let mut orbit_time_s = None;
             let (body_to_camera, sun_body, earth_body) = match spec.attitude_deg {
                 Some([yaw, pitch, roll]) => {
                     let r = Rotation::from_euler_zyx_deg(yaw, pitch, roll);
@@ -229,7 +268,21 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 }
                 None => {
                     let k = rng.gen_range(0..file.dataset.thermal_states);
-                    let (sun, earth) = pool_state(seed, illumination, k, disc_cos);
+                    let (sun, earth) = if transient {
+                        let t = orbit_state_time_s(
+                            &orbit,
+                            illumination,
+                            k,
+                            file.dataset.thermal_states,
+                        );
+                        let g = orbit.geometry(t);
+                        orbit_time_s = Some(g.time_s);
+                        // The shadow's ends are grid times: a state sits strictly inside
+                        // its arc, so its geometry agrees with its illumination.
+                        (g.sun_dir_body, g.earth_dir_body)
+                    } else {
+                        pool_state(seed, illumination, k, disc_cos)
+                    };
                     // Map the state's Earth direction onto the camera's, then turn freely
                     // about it: any such attitude shares the thermal state.
                     let spin = rng.gen_range(0.0..std::f64::consts::TAU);
@@ -276,6 +329,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 illumination,
                 sun_body_bits: sun_body.unwrap_or([0.0; 3]).map(f64::to_bits),
                 earth_body_bits: earth_body.map(f64::to_bits),
+                orbit_time_bits: orbit_time_s.map(f64::to_bits),
             };
             for (k, &scale) in scales.iter().enumerate() {
                 let index = plans.len();
@@ -307,4 +361,64 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         }
     }
     plans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TRANSIENT: &str = r#"
+[dataset]
+thermal_states = 4
+thermal = "transient"
+
+[[scene]]
+count = 8
+illumination = ["sunlit", "eclipse"]
+range_m = 30.0
+"#;
+
+    /// Transient states sit on the orbit: eclipse states inside the shadow (no Sun),
+    /// sunlit ones after it, their Sun and Earth directions the orbit's at their time;
+    /// steady files keep no orbit time.
+    #[test]
+    fn transient_states_follow_the_orbit() {
+        let file = SceneFile::parse(TRANSIENT, "transient.toml").unwrap();
+        assert_eq!(file.dataset.thermal, ThermalModel::Transient);
+        let orbit = thermal_orbit(&file);
+        let (p, e) = (orbit.period_s(), orbit.eclipse_duration_s());
+        let plans = plan(&file);
+        assert_eq!(plans.len(), 8);
+        for pl in &plans {
+            let t = pl.thermal.orbit_time_s().unwrap();
+            let g = orbit.geometry(t);
+            match pl.thermal.illumination {
+                Illumination::Eclipse => {
+                    assert!(t > 0.0 && t < e, "{t}");
+                    assert!(pl.thermal.sun_body().is_none() && pl.sun_dir_camera.is_none());
+                }
+                Illumination::Sunlit => {
+                    assert!(t > e && t < p, "{t}");
+                    assert_eq!(pl.thermal.sun_body(), g.sun_dir_body);
+                }
+            }
+            assert_eq!(pl.thermal.earth_body(), g.earth_dir_body);
+            // The camera sees the Earth where the state has it.
+            let e_cam = pl.body_to_camera.apply(g.earth_dir_body);
+            let d = crate::world::geom::sub(e_cam, pl.earth_dir_camera);
+            assert!(crate::world::geom::norm(d) < 1e-9);
+        }
+        let steady = SceneFile::parse(&TRANSIENT.replace("transient", "steady"), "s.toml").unwrap();
+        assert!(
+            plan(&steady)
+                .iter()
+                .all(|p| p.thermal.orbit_time_s().is_none())
+        );
+        let bad = SceneFile::parse(
+            &TRANSIENT.replace("\"transient\"", "\"periodic\""),
+            "b.toml",
+        );
+        let msg = bad.unwrap_err().to_string();
+        assert!(msg.contains("\"steady\" or \"transient\""), "{msg}");
+    }
 }

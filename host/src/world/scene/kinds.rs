@@ -86,6 +86,31 @@ impl Illumination {
     }
 }
 
+/// How the dataset's target temperatures are computed (`dataset.thermal`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ThermalModel {
+    /// Steady state for a random Sun and Earth direction (eclipse: the Earth's
+    /// infrared alone, the coldest possible state).
+    #[default]
+    Steady,
+    /// The periodic state on the reference orbit (Earth-pointing attitude, Sun in the
+    /// orbit plane), sampled at times along it: eclipse states at times since eclipse
+    /// entry, sunlit states along the sunlit arc (see
+    /// [`crate::world::spacecraft::thermal`]).
+    Transient,
+}
+
+impl ThermalModel {
+    /// "steady" or "transient".
+    pub fn label(&self) -> &'static str {
+        match self {
+            ThermalModel::Steady => "steady",
+            ThermalModel::Transient => "transient",
+        }
+    }
+}
+
 /// A number fixed, or drawn uniformly from `[min, max]` per image.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(

@@ -42,7 +42,7 @@ mod spec;
 mod tests;
 
 pub use camera::{Camera, ResponseName};
-pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel};
+pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
 pub use spec::{DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION, SceneSpec};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
@@ -252,6 +252,7 @@ fn explain(message: &str, key: Option<&str>) -> String {
         "source" => Some("\"builtin\" or \"netcdf\""),
         "bits" => Some("a bit depth 1..=16, or a list of them"),
         "moon" => Some("a table { probability = <0..1> }"),
+        "thermal" => Some("\"steady\" or \"transient\""),
         _ => None,
     };
     match accepted {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::DetectionScale;
 
-use super::kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel};
+use super::kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
 use crate::world::spacecraft::MaterialCase;
@@ -103,8 +103,13 @@ pub struct DatasetSettings {
     /// Master seed: every image's pose, Earth and noise derive from it and its index.
     pub seed: u64,
     /// Thermal states per (target, material, illumination): random-attitude images
-    /// pick one of these steady-state solutions and a camera view consistent with it.
+    /// pick one of these solutions (steady states, or times along the orbit with
+    /// `thermal = "transient"`) and a camera view consistent with it.
     pub thermal_states: usize,
+    /// Target temperatures: `"steady"` (default) or `"transient"` (the periodic
+    /// state on the orbit, sampled at times along it; random-attitude scenes only,
+    /// fixed attitudes keep the steady state).
+    pub thermal: ThermalModel,
 }
 
 impl Default for DatasetSettings {
@@ -113,6 +118,7 @@ impl Default for DatasetSettings {
             name: "custom".into(),
             seed: 1,
             thermal_states: 12,
+            thermal: ThermalModel::Steady,
         }
     }
 }

@@ -58,6 +58,60 @@ pub const FAR_RESOLUTION_M: f64 = 0.2;
 /// Thermal conductivity of aluminium alloy 6061-T6, W m⁻¹ K⁻¹ (ASM handbook value).
 pub const ALUMINIUM_CONDUCTIVITY_W_M_K: f64 = 167.0;
 
+/// Density of aluminium alloy 6061, kg m⁻³ (ASM *Aerospace Specification Metals*
+/// data sheet of 6061-T6: 2.70 g cm⁻³).
+pub const ALUMINIUM_DENSITY_KG_M3: f64 = 2700.0;
+
+/// Specific heat of aluminium alloy 6061 near room temperature, J kg⁻¹ K⁻¹ (ASM data
+/// sheet of 6061-T6: 0.896 J g⁻¹ °C⁻¹; pure aluminium 0.897, CRC Handbook). It falls to
+/// about 0.80 at 200 K and 0.68 at 150 K (CRC Handbook, aluminium): taking the room
+/// temperature value overestimates the capacity of a cold (eclipse) skin by up to
+/// ~25 %, so the computed eclipse cooling is slightly slow.
+pub const ALUMINIUM_SPECIFIC_HEAT_J_KG_K: f64 = 896.0;
+
+/// Areal heat capacity added by an aluminium honeycomb core, J m⁻² K⁻¹: a 15 mm core
+/// (thickness an *estimate* for a 40 kg microsatellite's panels) of 5056 alloy
+/// honeycomb, 3/16 in cells, 49.7 kg m⁻³ (3.1 lb ft⁻³, Hexcel HexWeb CR-III data
+/// sheet): 0.75 kg m⁻² × 896 J kg⁻¹ K⁻¹.
+pub const HONEYCOMB_CORE_J_M2_K: f64 = 0.015 * 49.7 * ALUMINIUM_SPECIFIC_HEAT_J_KG_K;
+
+/// Areal heat capacity added by the solar cells, J m⁻² K⁻¹: triple-junction GaAs/Ge
+/// cells of about 0.86 kg m⁻² (Azur Space 3G30C data sheet: 86 mg cm⁻²) at
+/// ~330 J kg⁻¹ K⁻¹ (germanium 320, GaAs 330, CRC Handbook) plus a 100 µm CMG cover
+/// glass (2.55 g cm⁻³, 0.26 kg m⁻²) at ~700 J kg⁻¹ K⁻¹ (borosilicate glass) and
+/// adhesive (neglected): 0.86·330 + 0.26·700 ≈ 466.
+pub const SOLAR_CELL_LAYER_J_M2_K: f64 = 0.86 * 330.0 + 0.255 * 700.0;
+
+/// Areal heat capacity added by an MLI blanket, J m⁻² K⁻¹: about 0.4 kg m⁻² for a
+/// 15–20 layer blanket with its outer Kapton layer (Gilmore, *Spacecraft Thermal
+/// Control Handbook*, Vol. I, ch. 5: blanket areal masses of 0.3–0.6 kg m⁻²) at
+/// ~1 000 J kg⁻¹ K⁻¹ (Kapton: 1 090, DuPont data sheet; aluminised Mylar ~1 100).
+/// Consistent with [`MLI_KAPTON`]'s simplification (blanket tied to the wall).
+pub const MLI_BLANKET_J_M2_K: f64 = 0.4 * 1000.0;
+
+/// Areal heat capacity of a surface of `material`, J m⁻² K⁻¹: its conducting aluminium
+/// skin (every material of this module conducts through a 6061 sheet of
+/// `thickness_m`: ρ c t = 2700 × 896 × t) plus the layers it carries, by material
+/// name: the honeycomb core of Tango's sandwich panels ([`HONEYCOMB_CORE_J_M2_K`]:
+/// `"solar-cells"`, `"black-paint"`, `"white-paint"`, `"mli-kapton"`), the cells of
+/// `"solar-cells"` ([`SOLAR_CELL_LAYER_J_M2_K`]) and the blanket of `"mli-kapton"`
+/// ([`MLI_BLANKET_J_M2_K`]). Paints (~0.1 kg m⁻²) are neglected.
+///
+/// Values: a 2 mm skin (cube + cylinder) 4 838; Tango's solar panel 3 549, white and
+/// black walls 3 087, MLI walls 3 487, antennas (2.5 mm rod shell) 6 048, radomes 2 419.
+pub fn areal_heat_capacity_j_m2_k(material: &Material) -> f64 {
+    let skin =
+        ALUMINIUM_DENSITY_KG_M3 * ALUMINIUM_SPECIFIC_HEAT_J_KG_K * material.thickness_m.max(0.0);
+    let core = HONEYCOMB_CORE_J_M2_K;
+    let added = match material.name {
+        n if n == SOLAR_CELLS.name => core + SOLAR_CELL_LAYER_J_M2_K,
+        n if n == PANEL_BACK.name || n == WHITE_PAINT.name => core,
+        n if n == MLI_KAPTON.name => core + MLI_BLANKET_J_M2_K,
+        _ => 0.0,
+    };
+    skin + added
+}
+
 /// Table 3 emissivity cases of the cube+cylinder target.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]

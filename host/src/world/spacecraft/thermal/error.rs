@@ -43,6 +43,19 @@ pub enum ThermalError {
         /// One facet of the group.
         facet: usize,
     },
+    /// A transient input (heat capacities, step, orbit, start temperatures) is out of
+    /// bounds.
+    BadTransient {
+        /// What is wrong.
+        reason: String,
+    },
+    /// The orbit integration did not become periodic within the orbit limit.
+    NotPeriodic {
+        /// Orbits integrated.
+        orbits: usize,
+        /// Largest |T(t + P) − T(t)| over the facets after the last orbit, K.
+        change_k: f64,
+    },
     /// Newton's method did not reach the tolerance.
     NoConvergence {
         /// Newton steps taken.
@@ -78,6 +91,13 @@ impl fmt::Display for ThermalError {
             ThermalError::NoSteadyState { facet } => write!(
                 f,
                 "thermal network: facet {facet} belongs to an enclosed group with dissipation and no radiating surface: no steady state"
+            ),
+            ThermalError::BadTransient { reason } => {
+                write!(f, "transient thermal: {reason}")
+            }
+            ThermalError::NotPeriodic { orbits, change_k } => write!(
+                f,
+                "transient thermal: not periodic after {orbits} orbits (largest change over the last orbit {change_k:.3} K)"
             ),
             ThermalError::NoConvergence {
                 iterations,

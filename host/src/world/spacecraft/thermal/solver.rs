@@ -96,22 +96,22 @@ impl ThermalNetwork {
     pub fn solve(&self, env: &ThermalEnvironment) -> Result<ThermalSolution, ThermalError> {
         let env = checked(env)?;
         let q = self.absorbed_w(&env)?;
+        self.solve_absorbed(&q, env.deep_space_k)
+    }
+
+    /// Steady-state temperatures for given absorbed powers `q` (W per facet, as
+    /// [`ThermalNetwork::absorbed_w`] returns) and sink temperature `ts` (K).
+    pub(super) fn solve_absorbed(
+        &self,
+        q: &[f64],
+        ts: f64,
+    ) -> Result<ThermalSolution, ThermalError> {
         let n = self.facet_count();
-        let ts = env.deep_space_k;
         let ts4 = ts.powi(4);
         let absorbed: f64 = q.iter().sum();
         let dissipated: f64 = self.dissipation.iter().sum();
         let input: Vec<f64> = (0..n).map(|i| q[i] + self.dissipation[i]).collect();
-        // Radiative coupling εσA of every exposed facet, W K⁻⁴.
-        let rad: Vec<f64> = (0..n)
-            .map(|i| {
-                if self.exposed[i] {
-                    self.eps[i] * SIGMA * self.area[i]
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let rad = self.radiative_coupling();
 
         // Start: the larger of the facet's own radiative equilibrium and its
         // component's uniform equilibrium.
@@ -190,6 +190,19 @@ impl ThermalNetwork {
         }
     }
 
+    /// Radiative coupling εσA of every exposed facet (0 for enclosed ones), W K⁻⁴.
+    pub(super) fn radiative_coupling(&self) -> Vec<f64> {
+        (0..self.facet_count())
+            .map(|i| {
+                if self.exposed[i] {
+                    self.eps[i] * SIGMA * self.area[i]
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
     /// Nodal residuals R = input − εσA(T⁴ − Ts⁴) − Σ G (Tᵢ − Tⱼ); returns max |R|.
     pub(super) fn residual(
         &self,
@@ -221,7 +234,7 @@ impl ThermalNetwork {
     }
 
     /// y = (diag − offdiag G)·x.
-    fn apply(&self, diag: &[f64], x: &[f64], y: &mut [f64]) {
+    pub(super) fn apply(&self, diag: &[f64], x: &[f64], y: &mut [f64]) {
         for i in 0..x.len() {
             let (s, e) = (self.row[i] as usize, self.row[i + 1] as usize);
             let mut acc = diag[i] * x[i];
