@@ -20,6 +20,7 @@ fn row(file: &str) -> TruthRow {
         roi: Roi::new(0, 0, 1, 1),
         groups: Vec::new(),
         range_m: None,
+        signal_to_clutter: None,
     }
 }
 
@@ -143,6 +144,7 @@ fn write_dataset(dir: &Path, n: usize) -> Vec<TruthRow> {
                 ("range".into(), "close".into()),
             ],
             range_m: Some(20.0 + i as f64),
+            signal_to_clutter: None,
         });
     }
     std::fs::write(dir.join("truth.csv"), csv).unwrap();

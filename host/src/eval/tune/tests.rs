@@ -50,6 +50,7 @@ fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
             roi: fx.truth,
             groups: Vec::new(),
             range_m: None,
+            signal_to_clutter: None,
         });
     }
     // Sets of different rules scored together score as each alone.
@@ -101,6 +102,7 @@ fn where_parses_and_filters() {
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect(),
         range_m: None,
+        signal_to_clutter: None,
     };
     let rows = [
         row("a", &[("mode", "radiometry"), ("range", "close")]),
