@@ -83,8 +83,9 @@ pub struct RunSummary {
     pub library_s: [f64; 3],
     /// Distinct meshes, thermal solutions and Earth maps.
     pub library_counts: (usize, usize, usize),
-    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write.
-    pub stage_cpu_s: [f64; 4],
+    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write,
+    /// signal-to-clutter twin.
+    pub stage_cpu_s: [f64; 5],
 }
 
 /// Renders every image of `file` into `dir` with labels (module docs).
@@ -167,6 +168,7 @@ pub fn write_dataset(
         summary.stage_cpu_s[1] += stats.earth_ns as f64 * 1e-9;
         summary.stage_cpu_s[2] += stats.expose_ns as f64 * 1e-9;
         summary.stage_cpu_s[3] += write_s;
+        summary.stage_cpu_s[4] += stats.clutter_ns as f64 * 1e-9;
         done.insert(rec.index, rec);
     }
     let t2 = Instant::now();

@@ -44,6 +44,9 @@ pub struct ImagePlan {
     pub earth_day: usize,
     /// Noise seed (`None`: noise off).
     pub noise_seed: Option<u64>,
+    /// Whether the target is rendered (false: a no-target frame,
+    /// [`SceneSpec::no_target_fraction`](crate::world::scene::SceneSpec::no_target_fraction)).
+    pub has_target: bool,
 }
 
 /// Identifies a thermal solution: target, material, resolution, illumination and the
@@ -117,6 +120,28 @@ fn pool_state(
     (sun, earth)
 }
 
+/// Which of a kind's `poses` have no target: the first ⌈`share` × `poses`⌉ of a
+/// permutation of the pose indices drawn from the dataset seed and the kind's index
+/// (its own stream, so the poses' other draws do not move).
+fn no_target_poses(seed: u64, scene: usize, poses: usize, share: f64) -> Vec<bool> {
+    let mut empty = vec![false; poses];
+    if share <= 0.0 || poses == 0 {
+        return empty;
+    }
+    let n = ((share * poses as f64).ceil() as usize).min(poses);
+    let mut order: Vec<usize> = (0..poses).collect();
+    let mut rng = rng_for(seed, 0x0E0E_0000 + scene as u64, 0);
+    // Partial Fisher–Yates: the first n places are a uniform n-subset.
+    for i in 0..n {
+        let j = rng.gen_range(i..poses);
+        order.swap(i, j);
+    }
+    for &p in &order[..n] {
+        empty[p] = true;
+    }
+    empty
+}
+
 /// The plan of every image of `file`, in index order.
 pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
     let seed = file.dataset.seed;
@@ -135,6 +160,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         let poses = spec.count / scales.len();
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
+        let no_target = no_target_poses(seed, si, poses, spec.no_target_fraction);
         for pose in 0..poses {
             let mut rng = rng_for(seed, si as u64 + 1, pose as u64);
             let combo = pose % (materials.len() * lights.len());
@@ -213,6 +239,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     noise_seed: spec.noise.then(|| {
                         splitmix64(splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))
                     }),
+                    has_target: !no_target[pose],
                 });
             }
         }

@@ -37,7 +37,7 @@ mod tests;
 
 pub use camera::Camera;
 pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
-pub use spec::{DatasetSettings, EarthModel, EarthSource, SceneSpec};
+pub use spec::{DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, SceneSpec};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -200,6 +200,12 @@ impl SceneFile {
         self.earth_model.validate()?;
         if self.scenes.is_empty() {
             return Err("no [[scene]] table: expected at least one scene kind".into());
+        }
+        let t = self.dataset.truth_coverage;
+        if !(t > 0.0 && t <= 1.0) {
+            return Err(format!(
+                "dataset.truth_coverage = {t}: expected a pixel coverage in (0, 1] (0.5: half covered)"
+            ));
         }
         if !(1..=1024).contains(&self.dataset.thermal_states) {
             return Err(format!(

@@ -105,6 +105,19 @@ pub struct DatasetSettings {
     /// Thermal states per (target, material, illumination): random-attitude images
     /// pick one of these steady-state solutions and a camera view consistent with it.
     pub thermal_states: usize,
+    /// Target coverage at or above which a pixel belongs to the truth box `x0,y0,x1,y1`
+    /// of `truth.csv` (0 < value ≤ 1; default [`DEFAULT_TRUTH_COVERAGE`]). The box of the pixels
+    /// covered more than ¼ is written beside it whatever this is.
+    #[serde(skip_serializing_if = "is_half")]
+    pub truth_coverage: f64,
+}
+
+/// The default truth-box coverage: a pixel at least half covered by the target (the
+/// renderer's mask, `imaging::render::MASK_COVERAGE`, the paper's convention).
+pub const DEFAULT_TRUTH_COVERAGE: f64 = 0.5;
+
+fn is_half(v: &f64) -> bool {
+    *v == DEFAULT_TRUTH_COVERAGE
 }
 
 impl Default for DatasetSettings {
@@ -113,6 +126,7 @@ impl Default for DatasetSettings {
             name: "custom".into(),
             seed: 1,
             thermal_states: 12,
+            truth_coverage: DEFAULT_TRUTH_COVERAGE,
         }
     }
 }
@@ -179,6 +193,18 @@ pub struct SceneSpec {
     /// Image-plane direction towards the Earth's centre, degrees from +x towards +y.
     #[serde(default = "full_circle")]
     pub earth_azimuth_deg: Param,
+    /// Share of this kind's poses rendered without the target (0..=1, default 0): the
+    /// same camera, Earth and noise, nothing to detect (`target = "none"` in the labels,
+    /// empty truth box). ⌈share × poses⌉ poses, picked by a permutation seeded from the
+    /// dataset seed and the kind's index, so they mix with every material and
+    /// illumination the poses cycle through; the other poses are unchanged. 1: a kind of
+    /// target-less frames only.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub no_target_fraction: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn one() -> usize {
@@ -333,6 +359,12 @@ impl SceneSpec {
         )?;
         self.earth_azimuth_deg
             .validate(&format!("{at}.earth_azimuth_deg"), -360.0, 720.0)?;
+        if !(0.0..=1.0).contains(&self.no_target_fraction) {
+            return Err(format!(
+                "{at}.no_target_fraction = {}: expected a share in 0..=1",
+                self.no_target_fraction
+            ));
+        }
         Ok(())
     }
 }
