@@ -68,6 +68,27 @@ pub enum TruthCoverage {
     Quarter,
 }
 
+impl TruthCoverage {
+    /// `half` or `quarter`.
+    pub fn from_name(name: &str) -> Option<TruthCoverage> {
+        match name {
+            "half" => Some(TruthCoverage::Half),
+            "quarter" => Some(TruthCoverage::Quarter),
+            _ => None,
+        }
+    }
+
+    /// Parses a `--truth-coverage` value, with an error naming the choices.
+    ///
+    /// # Errors
+    /// A message for anything but `half` or `quarter`.
+    pub fn parse(name: &str) -> Result<TruthCoverage, String> {
+        TruthCoverage::from_name(name).ok_or_else(|| {
+            format!("unknown truth coverage `{name}`; expected half (x0..y1) or quarter (x0_quarter..y1_quarter)")
+        })
+    }
+}
+
 /// The `truth.csv` columns of the quarter-coverage box ([`TruthCoverage::Quarter`]).
 pub const QUARTER_COLUMNS: [&str; 4] = ["x0_quarter", "y0_quarter", "x1_quarter", "y1_quarter"];
 
