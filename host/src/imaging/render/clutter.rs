@@ -173,3 +173,85 @@ pub fn signal_to_clutter(
         f64::from(frame.noise_sigma_dn),
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A uniform disc of contrast `c` (coverage 1 inside radius `r`, 0 outside) over a
+    /// checkerboard background `b0 ± a`.
+    fn disc_on_checkerboard(
+        w: usize,
+        h: usize,
+        centre: (f64, f64),
+        r: f64,
+        c: f32,
+        b0: f32,
+        a: f32,
+    ) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let (mut sig, mut bg, mut cov) = (vec![0f32; w * h], vec![0f32; w * h], vec![0f32; w * h]);
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                bg[i] = if (x + y) % 2 == 0 { b0 + a } else { b0 - a };
+                let inside = (x as f64 + 0.5 - centre.0).hypot(y as f64 + 0.5 - centre.1) < r;
+                cov[i] = if inside { 1.0 } else { 0.0 };
+                sig[i] = if inside { bg[i] + c } else { bg[i] };
+            }
+        }
+        (sig, bg, cov)
+    }
+
+    #[test]
+    fn uniform_disc_on_a_checkerboard_by_hand() {
+        // Disc of radius 5 px at (20, 20) in a 40 × 40 frame: its ≥ ½ box is the 10 × 10
+        // square [15, 25)², the ring 5 px wide (half the side): the 20 × 20 square
+        // [10, 30)² less the box, 300 pixels, 150 of each checkerboard colour, so the
+        // ring's σ is exactly a. Contrast c; gain g scales both.
+        let (w, h) = (40, 40);
+        let (c, b0, a, g) = (6.0f32, 100.0f32, 2.0f32, 3.0f64);
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, a);
+        let truth = super::super::mask_box(&cov, w);
+        assert_eq!(truth, Roi::new(15, 15, 25, 25));
+        assert_eq!(ring_width_px(truth), 5);
+        assert_eq!(ring_window(truth, w, h), Roi::new(10, 10, 30, 30));
+        let got = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-9 * y.abs().max(1.0);
+        assert!(close(got.target_contrast_dn, f64::from(c) * g), "{got:?}");
+        assert!(close(got.clutter_sigma_dn, f64::from(a) * g), "{got:?}");
+        assert!(close(got.signal_to_clutter, f64::from(c / a)), "{got:?}");
+        // A noise σ above the clutter becomes the denominator.
+        let noisy = clutter_statistics(&sig, &bg, &cov, w, truth, g, 60.0).unwrap();
+        assert!(close(noisy.signal_to_clutter, f64::from(c) * g / 60.0));
+        // A flat background, no noise: the quantisation floor 1/√12 DN.
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, 0.0);
+        let flat = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.0).unwrap();
+        assert_eq!(flat.clutter_sigma_dn, 0.0);
+        assert!(close(
+            flat.signal_to_clutter,
+            f64::from(c) * g * 12f64.sqrt()
+        ));
+        // A darker target: the contrast's magnitude.
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, -c, b0, a);
+        let dark = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        assert!(close(dark.target_contrast_dn, f64::from(c) * g));
+    }
+
+    #[test]
+    fn ring_is_cut_to_the_frame_and_empty_truth_gives_none() {
+        let truth = Roi::new(0, 0, 3, 2);
+        assert_eq!(ring_width_px(truth), RING_MIN_WIDTH_PX);
+        assert_eq!(ring_window(truth, 5, 50), Roi::new(0, 0, 5, 6));
+        let z = vec![0f32; 16];
+        assert_eq!(
+            clutter_statistics(&z, &z, &z, 4, Roi::EMPTY, 1.0, 0.0),
+            None
+        );
+        assert_eq!(QUANTISATION_SIGMA_DN, 1.0 / 12f64.sqrt());
+        // The scene file's default truth box is the renderer's mask.
+        assert_eq!(
+            crate::world::scene::DEFAULT_TRUTH_COVERAGE,
+            f64::from(MASK_COVERAGE)
+        );
+    }
+}
