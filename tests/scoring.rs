@@ -429,7 +429,7 @@ fn signal_to_clutter_against_a_full_frame_twin() {
         let gain = frame.mapping.gain_dn();
         let (mut diff, mut n) = (0.0, 0usize);
         let mut ring = Vec::new();
-        let band = 4usize.max((usize::from(t.width().max(t.height())) + 1) / 2) as i64;
+        let band = 4usize.max(usize::from(t.width().max(t.height())).div_ceil(2)) as i64;
         for y in 0..h {
             for x in 0..w {
                 let i = y * w + x;

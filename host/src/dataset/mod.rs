@@ -5,10 +5,13 @@
 //! - `NNNNNN.png`: 16-bit grayscale DN (the core's sensor model);
 //! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (the box: (x0, y0)
 //!   inclusive, (x1, y1) exclusive, the tight box of the pixels whose target coverage
-//!   is ≥ 0.5);
-//! - `coco.json`: COCO detection labels (one category, `spacecraft`);
+//!   is ≥ `[dataset] truth_coverage`, ½ by default; four empty fields when there is no
+//!   target), then `x0_quarter..y1_quarter` (coverage > ¼) and `signal_to_clutter`;
+//! - `coco.json`: COCO detection labels (one category, `spacecraft`; no annotation for
+//!   a frame without a target);
 //! - `metadata.jsonl`: one JSON object per image (pose, mode, scale, material,
-//!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures);
+//!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures, both
+//!   boxes, the signal-to-clutter ratio and its parts; [`ImageRecord`]);
 //! - `masks/NNNNNN.png` (optional): 8-bit target coverage, 255 = fully covered;
 //! - `preview/NNNNNN.png` (optional): contrast-stretched 8-bit RGB with the truth box.
 //!

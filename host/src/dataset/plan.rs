@@ -161,7 +161,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
         let no_target = no_target_poses(seed, si, poses, spec.no_target_fraction);
-        for pose in 0..poses {
+        for (pose, &empty) in no_target.iter().enumerate() {
             let mut rng = rng_for(seed, si as u64 + 1, pose as u64);
             let combo = pose % (materials.len() * lights.len());
             let material = materials[combo % materials.len()];
@@ -239,7 +239,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     noise_seed: spec.noise.then(|| {
                         splitmix64(splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))
                     }),
-                    has_target: !no_target[pose],
+                    has_target: !empty,
                 });
             }
         }
