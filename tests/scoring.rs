@@ -11,6 +11,7 @@ use std::path::Path;
 use cli_common::run;
 use serde_json::Value;
 use tirroi::host::dataset::{Library, plan};
+use tirroi::host::eval::scoring::read_truth;
 use tirroi::host::world::scene::SceneFile;
 
 /// Two kinds on a small frame and a coarse Earth: deep space without noise, on the
@@ -199,6 +200,25 @@ fn no_target_frames_boxes_and_signal_to_clutter() {
         }
     }
     assert!(quarter_larger, "the ¼ box grows past the ½ box somewhere");
+
+    // eval's reader: the ratio from truth.csv, and from metadata.jsonl beside a
+    // truth file without the column; none for the target-less frames.
+    let full = read_truth(&ds.join("truth.csv")).unwrap();
+    let bare: String = fs::read_to_string(ds.join("truth.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').take(13).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    fs::write(ds.join("bare.csv"), bare).unwrap();
+    let from_meta = read_truth(&ds.join("bare.csv")).unwrap();
+    for (i, (a, b)) in full.iter().zip(&from_meta).enumerate() {
+        assert_eq!(a.has_target(), !none.contains(&i));
+        let want = meta[i]["signal_to_clutter"].as_f64();
+        assert_eq!(b.signal_to_clutter, want);
+        let csv_value = a.signal_to_clutter.map(|v| format!("{v:.4}"));
+        assert_eq!(csv_value, want.map(|v| format!("{v:.4}")));
+        assert_eq!(a.groups, b.groups);
+    }
 }
 
 #[test]

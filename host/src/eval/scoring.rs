@@ -7,7 +7,8 @@
 //! convention, `docs/architecture.md`: x0, y0 inclusive, x1, y1 exclusive); extra
 //! columns become group labels when they are one of `mode`, `scale`, `target`,
 //! `material`, `illumination`, `range_m` gives the range band (close ≤ 50 m, far
-//! ≥ 300 m, else mid) and `signal_to_clutter` the SCR bin ([`scr_bin`]). Timing is the
+//! ≥ 300 m, else mid) and `signal_to_clutter` the SCR bin ([`scr_bin`]; without that
+//! column, from the `metadata.jsonl` beside `truth.csv` when there is one). Timing is the
 //! core call alone on one thread, the median of `repeat` runs; images are scored in
 //! parallel.
 //!
@@ -251,7 +252,38 @@ pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<Truth
             signal_to_clutter,
         });
     }
+    if !header.contains(&"signal_to_clutter") {
+        scr_from_metadata(path, &mut rows);
+    }
     Ok(rows)
+}
+
+/// For a `truth.csv` without a `signal_to_clutter` column: the ratios of the
+/// `metadata.jsonl` beside it (the dataset's, by file name), when there is one.
+/// Unreadable lines and files are skipped: the ratio only adds a group.
+fn scr_from_metadata(truth: &Path, rows: &mut [TruthRow]) {
+    let Some(text) = truth
+        .parent()
+        .and_then(|d| std::fs::read_to_string(d.join("metadata.jsonl")).ok())
+    else {
+        return;
+    };
+    let mut by_file = BTreeMap::new();
+    for line in text.lines() {
+        if let Ok(v) = serde_json::from_str::<serde_json::Value>(line) {
+            if let (Some(f), Some(r)) = (v["file"].as_str(), v["signal_to_clutter"].as_f64()) {
+                by_file.insert(f.to_string(), r);
+            }
+        }
+    }
+    for row in rows.iter_mut().filter(|r| r.has_target()) {
+        if let Some(&r) = by_file.get(&row.file) {
+            if r.is_finite() {
+                row.groups.push(("scr".into(), scr_bin(r).into()));
+                row.signal_to_clutter = Some(r);
+            }
+        }
+    }
 }
 
 /// One detector on one frame.
