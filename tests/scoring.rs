@@ -490,3 +490,34 @@ fn signal_to_clutter_against_a_full_frame_twin() {
     }
     assert_eq!(checked, [2, 3]);
 }
+
+#[test]
+fn truth_coverage_sets_the_main_box() {
+    // ¾: the pixels covered at least 12/16, written as round(191.25) = 191 in the mask
+    // (11/16 as 175); the ¼ box stays as it was.
+    let tmp = tempfile::tempdir().unwrap();
+    render(
+        tmp.path(),
+        &TINY.replace(
+            "thermal_states = 1",
+            "thermal_states = 1\ntruth_coverage = 0.75",
+        ),
+    );
+    let ds = tmp.path().join("ds");
+    let (h, rows) = csv(&ds.join("truth.csv"));
+    let (x0, x0q) = (col(&h, "x0"), col(&h, "x0_quarter"));
+    let meta = metadata(&ds);
+    let mut smaller = false;
+    for (i, row) in rows.iter().enumerate() {
+        let (mask, w) = mask(&ds, &row[0]);
+        let main = parse_box(&row[x0..x0 + 4]);
+        assert_eq!(main, brute_box(&mask, w, |v| v >= 191), "{}", row[0]);
+        assert_eq!(
+            parse_box(&row[x0q..x0q + 4]),
+            brute_box(&mask, w, |v| v > 64)
+        );
+        smaller |= main != brute_box(&mask, w, |v| v >= 128);
+        assert_eq!(meta[i]["truth_coverage"], 0.75);
+    }
+    assert!(smaller, "a ¾ box inside the ½ box somewhere");
+}
