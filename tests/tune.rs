@@ -21,6 +21,7 @@ fn row(file: &str) -> TruthRow {
         groups: Vec::new(),
         range_m: None,
         bits: None,
+        signal_to_clutter: None,
     }
 }
 
@@ -145,6 +146,7 @@ fn write_dataset(dir: &Path, n: usize) -> Vec<TruthRow> {
             ],
             range_m: Some(20.0 + i as f64),
             bits: None,
+            signal_to_clutter: None,
         });
     }
     std::fs::write(dir.join("truth.csv"), csv).unwrap();

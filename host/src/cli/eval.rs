@@ -39,6 +39,11 @@ pub struct EvalArgs {
     /// box on the previous one; one thread).
     #[arg(long, default_value = "off", value_parser = parse_track)]
     pub track: scoring::Track,
+    /// Which truth box scores: half (x0,y0,x1,y1: pixels covered at least the
+    /// dataset's truth_coverage, ½ by default) or quarter (x0_quarter..y1_quarter:
+    /// pixels covered more than ¼). Scoring: docs/results.md § Scoring.
+    #[arg(long, default_value = "half", value_parser = scoring::TruthCoverage::parse)]
+    pub truth_coverage: scoring::TruthCoverage,
 }
 
 fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
@@ -77,7 +82,7 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         args.out.as_deref(),
     );
     let truth = truth.map_or_else(|| images.join("truth.csv"), Path::to_path_buf);
-    let rows = scoring::read_truth(&truth).map_err(|e| e.to_string())?;
+    let rows = scoring::read_truth_with(&truth, args.truth_coverage).map_err(|e| e.to_string())?;
     let bar = progress::bar(rows.len(), "frames");
     let scores = scoring::score(images, &rows, options, &DetectorBank::default, &|| {
         bar.inc(1)

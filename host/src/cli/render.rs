@@ -103,11 +103,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         s.wall_s[2],
     );
     println!(
-        "per-image CPU time by stage: target {:.1} % | Earth {:.1} % | DN + noise {:.1} % | PNG encode + write {:.1} % ({:.2} ms per image)",
+        "per-image CPU time by stage: target {:.1} % | Earth {:.1} % | DN + noise {:.1} % | PNG encode + write {:.1} % | signal-to-clutter twin {:.1} % ({:.2} ms per image)",
         pct(s.stage_cpu_s[0]),
         pct(s.stage_cpu_s[1]),
         pct(s.stage_cpu_s[2]),
         pct(s.stage_cpu_s[3]),
+        pct(s.stage_cpu_s[4]),
         if s.rendered > 0 {
             cpu * 1e3 / s.rendered as f64
         } else {

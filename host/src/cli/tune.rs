@@ -40,6 +40,11 @@ pub struct TuneArgs {
     /// Write trials.csv (method,params,mean_iou,median_iou,mean_time_ms) here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Which truth box scores: half (x0,y0,x1,y1: pixels covered at least the
+    /// dataset's truth_coverage, ½ by default) or quarter (x0_quarter..y1_quarter:
+    /// pixels covered more than ¼). Scoring: docs/results.md § Scoring.
+    #[arg(long, default_value = "half", value_parser = scoring::TruthCoverage::parse)]
+    pub truth_coverage: scoring::TruthCoverage,
 }
 
 /// Runs `tirroi tune`: filters the rows, splits them, searches each method on the tune
@@ -54,7 +59,7 @@ pub fn run(args: &TuneArgs) -> Result<(), String> {
         .truth
         .clone()
         .unwrap_or_else(|| args.images.join("truth.csv"));
-    let rows = scoring::read_truth(&truth).map_err(|e| e.to_string())?;
+    let rows = scoring::read_truth_with(&truth, args.truth_coverage).map_err(|e| e.to_string())?;
     let rows = filter(&rows, &args.wheres);
     if rows.is_empty() {
         let w: Vec<String> = args

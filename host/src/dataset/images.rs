@@ -16,6 +16,9 @@ use crate::imaging::render::{self, Rendered};
 use crate::world::geom::Vec3;
 use crate::world::scene::{SceneFile, TargetModel};
 
+/// The `target` label of a frame rendered without the target.
+pub const NO_TARGET: &str = "none";
+
 /// The labels and metadata of one image (a line of `metadata.jsonl`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImageRecord {
@@ -25,15 +28,23 @@ pub struct ImageRecord {
     pub file: String,
     /// Scene kind name.
     pub scene: String,
-    /// Truth box [x0, y0, x1, y1) (all 0 when the target is not in the frame).
+    /// Truth box [x0, y0, x1, y1) of the pixels covered at least `truth_coverage` (all
+    /// 0 when no target is in the frame).
     pub bbox: [u16; 4],
+    /// The coverage threshold of `bbox` (the scene file's `dataset.truth_coverage`).
+    #[serde(default = "half")]
+    pub truth_coverage: f64,
+    /// Truth box of the pixels covered more than ¼ (⊇ `bbox` at the default ½; all 0
+    /// when none).
+    #[serde(default)]
+    pub bbox_quarter: [u16; 4],
     /// Pixels in the target mask (coverage ≥ 0.5).
     pub mask_px: usize,
     /// "radiometry" or "detection".
     pub mode: String,
     /// Table 5 scale (detection).
     pub scale: Option<u8>,
-    /// Target model.
+    /// Target model, or "none" for a frame rendered without the target.
     pub target: String,
     /// Table 3 case (cube + cylinder).
     pub material: Option<String>,
@@ -57,6 +68,17 @@ pub struct ImageRecord {
     pub dn_offset: f64,
     /// Noise σ, DN (0: noise off).
     pub noise_sigma_dn: f32,
+    /// |Mean target − background| over the mask, noise-free, DN (`None`: no target
+    /// pixel at coverage ≥ ½); `imaging::render::clutter`.
+    #[serde(default)]
+    pub target_contrast_dn: Option<f64>,
+    /// Standard deviation of the target-less background in a ring around the truth
+    /// box, noise-free, DN (`None` as above).
+    #[serde(default)]
+    pub clutter_sigma_dn: Option<f64>,
+    /// Contrast / max(clutter σ, noise σ, 1/√12 DN) (`None` as above).
+    #[serde(default)]
+    pub signal_to_clutter: Option<f64>,
     /// Noise seed.
     pub noise_seed: Option<u64>,
     /// Bit depth of the DN map (scene `bits`, else the camera's): the PNG is 16-bit,
@@ -102,6 +124,10 @@ fn unit() -> f64 {
     1.0
 }
 
+fn half() -> f64 {
+    crate::world::scene::DEFAULT_TRUTH_COVERAGE
+}
+
 pub(super) fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
     let tmp = path.with_extension(format!(
         "{}.part",
@@ -131,6 +157,12 @@ fn record(
     thermal: &ThermalState,
 ) -> ImageRecord {
     let spec = &file.scenes[plan.scene];
+    let threshold = file.dataset.truth_coverage as f32;
+    let bbox = if threshold == render::MASK_COVERAGE {
+        frame.truth
+    } else {
+        render::coverage_box(&frame.coverage, frame.width, |c| c >= threshold)
+    };
     ImageRecord {
         index: plan.index,
         file: format!("{:06}.png", plan.index),
@@ -138,7 +170,9 @@ fn record(
             .name
             .clone()
             .unwrap_or_else(|| format!("scene-{}", plan.scene)),
-        bbox: frame.truth.to_array(),
+        bbox: bbox.to_array(),
+        truth_coverage: file.dataset.truth_coverage,
+        bbox_quarter: frame.truth_quarter.to_array(),
         mask_px: frame
             .coverage
             .iter()
@@ -146,8 +180,12 @@ fn record(
             .count(),
         mode: plan.mode.label().into(),
         scale: plan.scale,
-        target: plan.thermal.target.label().into(),
-        material: (plan.thermal.target == TargetModel::CubeCylinder)
+        target: if plan.has_target {
+            plan.thermal.target.label().into()
+        } else {
+            NO_TARGET.into()
+        },
+        material: (plan.has_target && plan.thermal.target == TargetModel::CubeCylinder)
             .then(|| plan.thermal.material.label().to_string()),
         illumination: plan.thermal.illumination.label().into(),
         range_m: plan.range_m,
@@ -159,6 +197,9 @@ fn record(
         dn_gain: frame.mapping.gain_dn(),
         dn_offset: frame.mapping.offset_dn(),
         noise_sigma_dn: frame.noise_sigma_dn,
+        target_contrast_dn: frame.clutter.map(|c| c.target_contrast_dn),
+        clutter_sigma_dn: frame.clutter.map(|c| c.clutter_sigma_dn),
+        signal_to_clutter: frame.clutter.map(|c| c.signal_to_clutter),
         noise_seed: plan.noise_seed,
         bits: frame.mapping.bits(),
         gain_factor: plan.gain_factor,

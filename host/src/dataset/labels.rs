@@ -15,16 +15,25 @@ pub(super) fn write_labels<'a>(
     records: impl Iterator<Item = &'a ImageRecord>,
 ) -> Result<(), DatasetError> {
     let mut csv = String::from(
-        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits\n",
+        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter\n",
     );
     let mut jsonl = String::new();
     let mut images = Vec::new();
     let mut annotations = Vec::new();
+    // An empty box (no target in view) is written as empty fields: no target.
+    let boxed = |b: [u16; 4]| {
+        if Roi::new(b[0], b[1], b[2], b[3]).is_empty() {
+            ",,,".to_string()
+        } else {
+            format!("{},{},{},{}", b[0], b[1], b[2], b[3])
+        }
+    };
     for r in records {
         let [x0, y0, x1, y1] = r.bbox;
         csv.push_str(&format!(
-            "{},{x0},{y0},{x1},{y1},{},{},{},{},{},{:.3},{:.4},{},{}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{}\n",
             r.file,
+            boxed(r.bbox),
             r.mode,
             r.scale.map_or(String::new(), |s| s.to_string()),
             r.target,
@@ -34,6 +43,9 @@ pub(super) fn write_labels<'a>(
             r.earth_fraction,
             r.noise_seed.map_or(String::new(), |s| s.to_string()),
             r.bits,
+            boxed(r.bbox_quarter),
+            r.signal_to_clutter
+                .map_or(String::new(), |s| format!("{s:.4}")),
         ));
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');

@@ -324,7 +324,7 @@ impl Library {
                 Some(3) => Readout::Detection(DetectionScale::Scale3),
                 Some(_) => Readout::Detection(DetectionScale::Scale1),
             },
-            target: Some(TargetView {
+            target: plan.has_target.then(|| TargetView {
                 mesh,
                 temperature_k: &thermal.temperature_k,
                 body_to_camera: plan.body_to_camera,
@@ -341,8 +341,11 @@ impl Library {
                 sun_dir_camera: m.sun_dir_camera,
             }),
         };
-        let frame = render::render(&input)
-            .map_err(|e| DatasetError(format!("image {}: {e}", plan.index)))?;
+        let err = |e: render::RenderError| DatasetError(format!("image {}: {e}", plan.index));
+        let mut frame = render::render(&input).map_err(err)?;
+        let t = std::time::Instant::now();
+        frame.clutter = render::signal_to_clutter(&input, &frame).map_err(err)?;
+        frame.stats.clutter_ns = t.elapsed().as_nanos() as u64;
         Ok((frame, thermal))
     }
 }

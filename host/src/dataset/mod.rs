@@ -5,10 +5,13 @@
 //! - `NNNNNN.png`: 16-bit grayscale DN (the core's sensor model);
 //! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (the box: (x0, y0)
 //!   inclusive, (x1, y1) exclusive, the tight box of the pixels whose target coverage
-//!   is ≥ 0.5);
-//! - `coco.json`: COCO detection labels (one category, `spacecraft`);
+//!   is ≥ `[dataset] truth_coverage`, ½ by default; four empty fields when there is no
+//!   target), then `x0_quarter..y1_quarter` (coverage > ¼) and `signal_to_clutter`;
+//! - `coco.json`: COCO detection labels (one category, `spacecraft`; no annotation for
+//!   a frame without a target);
 //! - `metadata.jsonl`: one JSON object per image (pose, mode, scale, material,
-//!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures);
+//!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures, both
+//!   boxes, the signal-to-clutter ratio and its parts; [`ImageRecord`]);
 //! - `masks/NNNNNN.png` (optional): 8-bit target coverage, 255 = fully covered;
 //! - `preview/NNNNNN.png` (optional): contrast-stretched 8-bit RGB with the truth box.
 //!
@@ -83,8 +86,9 @@ pub struct RunSummary {
     pub library_s: [f64; 3],
     /// Distinct meshes, thermal solutions and Earth maps.
     pub library_counts: (usize, usize, usize),
-    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write.
-    pub stage_cpu_s: [f64; 4],
+    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write,
+    /// signal-to-clutter twin.
+    pub stage_cpu_s: [f64; 5],
 }
 
 /// Renders every image of `file` into `dir` with labels (module docs).
@@ -167,6 +171,7 @@ pub fn write_dataset(
         summary.stage_cpu_s[1] += stats.earth_ns as f64 * 1e-9;
         summary.stage_cpu_s[2] += stats.expose_ns as f64 * 1e-9;
         summary.stage_cpu_s[3] += write_s;
+        summary.stage_cpu_s[4] += stats.clutter_ns as f64 * 1e-9;
         done.insert(rec.index, rec);
     }
     let t2 = Instant::now();

@@ -54,6 +54,9 @@ pub struct ImagePlan {
     pub bits: u8,
     /// The Moon, when it is in the field of view.
     pub moon: Option<MoonPlan>,
+    /// Whether the target is rendered (false: a no-target frame,
+    /// [`SceneSpec::no_target_fraction`](crate::world::scene::SceneSpec::no_target_fraction)).
+    pub has_target: bool,
 }
 
 /// Where the Moon is and where its Sun is, camera frame.
@@ -204,6 +207,28 @@ fn pool_state(
     (sun, earth)
 }
 
+/// Which of a kind's `poses` have no target: the first ⌈`share` × `poses`⌉ of a
+/// permutation of the pose indices drawn from the dataset seed and the kind's index
+/// (its own stream, so the poses' other draws do not move).
+fn no_target_poses(seed: u64, scene: usize, poses: usize, share: f64) -> Vec<bool> {
+    let mut empty = vec![false; poses];
+    if share <= 0.0 || poses == 0 {
+        return empty;
+    }
+    let n = ((share * poses as f64).ceil() as usize).min(poses);
+    let mut order: Vec<usize> = (0..poses).collect();
+    let mut rng = rng_for(seed, 0x0E0E_0000 + scene as u64, 0);
+    // Partial Fisher–Yates: the first n places are a uniform n-subset.
+    for i in 0..n {
+        let j = rng.gen_range(i..poses);
+        order.swap(i, j);
+    }
+    for &p in &order[..n] {
+        empty[p] = true;
+    }
+    empty
+}
+
 /// The plan of every image of `file`, in index order.
 pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
     let seed = file.dataset.seed;
@@ -225,7 +250,8 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
         let focal_px = file.camera.focal_px();
-        for pose in 0..poses {
+        let no_target = no_target_poses(seed, si, poses, spec.no_target_fraction);
+        for (pose, &empty) in no_target.iter().enumerate() {
             let mut rng = rng_for(seed, si as u64 + 1, pose as u64);
             let combo = pose % (materials.len() * lights.len());
             let material = materials[combo % materials.len()];
@@ -356,6 +382,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     netd_factor,
                     bits,
                     moon,
+                    has_target: !empty,
                 });
             }
         }

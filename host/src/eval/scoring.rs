@@ -1,13 +1,25 @@
 //! Scoring detectors on a directory of frames with a `truth.csv` (ours or anyone's):
 //! IoU against the truth box and the core's run time, per method and per group
-//! (material case, scale, illumination, range band, target), as the paper's Tables 6–8.
+//! (material case, scale, illumination, range band, target, signal-to-clutter bin),
+//! as the paper's Tables 6–8.
 //!
 //! `truth.csv` needs the columns `file,x0,y0,x1,y1` first (the project's box
 //! convention, `docs/architecture.md`: x0, y0 inclusive, x1, y1 exclusive); extra
 //! columns become group labels when they are one of `mode`, `scale`, `target`,
-//! `material`, `illumination`, and `range_m` gives the range band (close ≤ 50 m, far
-//! ≥ 300 m, else mid). Timing is the core call alone on one
-//! thread, the median of `repeat` runs; images are scored in parallel.
+//! `material`, `illumination`, `range_m` gives the range band (close ≤ 50 m, far
+//! ≥ 300 m, else mid) and `signal_to_clutter` the SCR bin ([`scr_bin`]; without that
+//! column, from the `metadata.jsonl` beside `truth.csv` when there is one). Timing is the
+//! core call alone on one thread, the median of `repeat` runs; images are scored in
+//! parallel.
+//!
+//! **The scoring definition** (one everywhere: `tirroi eval`, `tune`, `paper`'s tables
+//! and plots; `docs/results.md` § Scoring). A frame has a target when its truth box is
+//! not empty (empty `x0..y1` fields, or a zero-area box as older files wrote for a
+//! target out of view, mean *no target*). Over a group's frames with a target: mean
+//! and median IoU (a frame where the detector returned no box scores 0) and the hit
+//! rate, the share with IoU ≥ [`HIT_IOU`]. Over its frames without a target: the
+//! false-alarm rate, the share where the detector returned any box. Times are over
+//! all frames.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -35,6 +47,71 @@ pub struct TruthRow {
     /// Bit depth of the frame's DN, when the file has a `bits` column: it takes
     /// precedence over [`EvalOptions::bits`] for this frame.
     pub bits: Option<u8>,
+    /// Signal-to-clutter ratio, when the file has a `signal_to_clutter` column and the
+    /// frame a target.
+    pub signal_to_clutter: Option<f64>,
+}
+
+impl TruthRow {
+    /// Whether the frame has a target (its truth box is not empty).
+    pub fn has_target(&self) -> bool {
+        !self.roi.is_empty()
+    }
+}
+
+/// IoU at or above which a frame counts as a hit (the paper's and COCO's ½).
+pub const HIT_IOU: f32 = 0.5;
+
+/// Which truth box of a `truth.csv` to score against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TruthCoverage {
+    /// `x0,y0,x1,y1`: pixels covered at least the dataset's `truth_coverage` (½ by default).
+    #[default]
+    Half,
+    /// `x0_quarter,y0_quarter,x1_quarter,y1_quarter`: pixels covered more than ¼.
+    Quarter,
+}
+
+impl TruthCoverage {
+    /// `half` or `quarter`.
+    pub fn from_name(name: &str) -> Option<TruthCoverage> {
+        match name {
+            "half" => Some(TruthCoverage::Half),
+            "quarter" => Some(TruthCoverage::Quarter),
+            _ => None,
+        }
+    }
+
+    /// Parses a `--truth-coverage` value, with an error naming the choices.
+    ///
+    /// # Errors
+    /// A message for anything but `half` or `quarter`.
+    pub fn parse(name: &str) -> Result<TruthCoverage, String> {
+        TruthCoverage::from_name(name).ok_or_else(|| {
+            format!("unknown truth coverage `{name}`; expected half (x0..y1) or quarter (x0_quarter..y1_quarter)")
+        })
+    }
+}
+
+/// The `truth.csv` columns of the quarter-coverage box ([`TruthCoverage::Quarter`]).
+pub const QUARTER_COLUMNS: [&str; 4] = ["x0_quarter", "y0_quarter", "x1_quarter", "y1_quarter"];
+
+/// The signal-to-clutter bins eval reports, upper bounds exclusive: `<1`, `1-3`,
+/// `3-10`, `>=10` (below 1 the target is fainter than the background's own variation;
+/// from 10 on it stands far above it).
+pub const SCR_BIN_EDGES: [f64; 3] = [1.0, 3.0, 10.0];
+
+/// The bin label of a signal-to-clutter ratio ([`SCR_BIN_EDGES`]); the group key is `scr`.
+pub fn scr_bin(scr: f64) -> &'static str {
+    if scr < SCR_BIN_EDGES[0] {
+        "<1"
+    } else if scr < SCR_BIN_EDGES[1] {
+        "1-3"
+    } else if scr < SCR_BIN_EDGES[2] {
+        "3-10"
+    } else {
+        ">=10"
+    }
 }
 
 /// Columns that become groups; `range_m` becomes `range` (close / mid / far).
@@ -64,12 +141,22 @@ pub fn range_band(range_m: f64) -> &'static str {
     }
 }
 
-/// Reads `truth.csv`.
+/// Reads `truth.csv`, scoring against the `x0,y0,x1,y1` box ([`TruthCoverage::Half`]).
 ///
 /// # Errors
-/// [`EvalError`] naming the file and line for a missing header, a short row, or a box
-/// that is not four integers with x0 ≤ x1, y0 ≤ y1.
+/// As [`read_truth_with`].
 pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
+    read_truth_with(path, TruthCoverage::Half)
+}
+
+/// Reads `truth.csv` with the box of `coverage`. Four empty box fields mean no target
+/// (as does a zero-area box).
+///
+/// # Errors
+/// [`EvalError`] naming the file and line for a missing header (or missing quarter
+/// columns for [`TruthCoverage::Quarter`]), a short row, or a box that is neither four
+/// empty fields nor four integers with x0 ≤ x1, y0 ≤ y1.
+pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<TruthRow>, EvalError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| EvalError(format!("{}: cannot read: {e}", path.display())))?;
     let mut lines = text.lines().enumerate();
@@ -84,6 +171,22 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             header.join(",")
         )));
     }
+    let box_columns: [usize; 4] = match coverage {
+        TruthCoverage::Half => [1, 2, 3, 4],
+        TruthCoverage::Quarter => {
+            let mut at = [0usize; 4];
+            for (k, name) in QUARTER_COLUMNS.iter().enumerate() {
+                at[k] = header.iter().position(|h| h == name).ok_or_else(|| {
+                    EvalError(format!(
+                        "{}:1: no `{name}` column: the quarter-coverage box needs {} (a dataset rendered by this version)",
+                        path.display(),
+                        QUARTER_COLUMNS.join(",")
+                    ))
+                })?;
+            }
+            at
+        }
+    };
     let mut rows = Vec::new();
     for (i, line) in lines {
         if line.trim().is_empty() {
@@ -99,15 +202,20 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
             )));
         }
         let mut b = [0u16; 4];
-        for (k, v) in b.iter_mut().enumerate() {
-            *v = cols[k + 1].parse().map_err(|_| {
-                EvalError(format!(
-                    "{}: {} = `{}`: expected an integer 0..=65535",
-                    at(),
-                    header[k + 1],
-                    cols[k + 1]
-                ))
-            })?;
+        let field = |c: usize| cols.get(c).copied().unwrap_or("");
+        let empty = box_columns.iter().all(|&c| field(c).is_empty());
+        if !empty {
+            for (k, v) in b.iter_mut().enumerate() {
+                let c = box_columns[k];
+                *v = field(c).parse().map_err(|_| {
+                    EvalError(format!(
+                        "{}: {} = `{}`: expected an integer 0..=65535 (or all four box fields empty: no target)",
+                        at(),
+                        header[c],
+                        field(c)
+                    ))
+                })?;
+            }
         }
         if b[0] > b[2] || b[1] > b[3] {
             return Err(EvalError(format!(
@@ -115,9 +223,11 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
                 at()
             )));
         }
+        let roi = Roi::new(b[0], b[1], b[2], b[3]);
         let mut groups = Vec::new();
         let mut range_m = None;
         let mut bits = None;
+        let mut signal_to_clutter = None;
         for (name, value) in header.iter().zip(&cols).skip(5) {
             if value.is_empty() {
                 continue;
@@ -142,17 +252,56 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
                     groups.push(("range".into(), range_band(r).into()));
                     range_m = Some(r);
                 }
+            } else if *name == "signal_to_clutter" && !roi.is_empty() {
+                if let Ok(r) = value.parse::<f64>() {
+                    if r.is_finite() {
+                        groups.push(("scr".into(), scr_bin(r).into()));
+                        signal_to_clutter = Some(r);
+                    }
+                }
             }
         }
         rows.push(TruthRow {
             file: cols[0].to_string(),
-            roi: Roi::new(b[0], b[1], b[2], b[3]),
+            roi,
             groups,
             range_m,
             bits,
+            signal_to_clutter,
         });
     }
+    if !header.contains(&"signal_to_clutter") {
+        scr_from_metadata(path, &mut rows);
+    }
     Ok(rows)
+}
+
+/// For a `truth.csv` without a `signal_to_clutter` column: the ratios of the
+/// `metadata.jsonl` beside it (the dataset's, by file name), when there is one.
+/// Unreadable lines and files are skipped: the ratio only adds a group.
+fn scr_from_metadata(truth: &Path, rows: &mut [TruthRow]) {
+    let Some(text) = truth
+        .parent()
+        .and_then(|d| std::fs::read_to_string(d.join("metadata.jsonl")).ok())
+    else {
+        return;
+    };
+    let mut by_file = BTreeMap::new();
+    for line in text.lines() {
+        if let Ok(v) = serde_json::from_str::<serde_json::Value>(line) {
+            if let (Some(f), Some(r)) = (v["file"].as_str(), v["signal_to_clutter"].as_f64()) {
+                by_file.insert(f.to_string(), r);
+            }
+        }
+    }
+    for row in rows.iter_mut().filter(|r| r.has_target()) {
+        if let Some(&r) = by_file.get(&row.file) {
+            if r.is_finite() {
+                row.groups.push(("scr".into(), scr_bin(r).into()));
+                row.signal_to_clutter = Some(r);
+            }
+        }
+    }
 }
 
 /// One detector on one frame.
@@ -164,9 +313,9 @@ pub struct FrameScore {
     pub method: &'static str,
     /// Predicted box, `None` when nothing was found.
     pub bbox: Option<[u16; 4]>,
-    /// Truth box.
+    /// Truth box (all 0: no target).
     pub truth: [u16; 4],
-    /// IoU of prediction and truth (0 when none).
+    /// IoU of prediction and truth (0 when none, and on a frame without a target).
     pub iou: f32,
     /// Median core time over the repeats, µs.
     pub time_us: f64,
@@ -174,6 +323,25 @@ pub struct FrameScore {
     pub groups: Vec<(String, String)>,
     /// Camera–target distance, m, when known.
     pub range_m: Option<f64>,
+}
+
+impl FrameScore {
+    /// Whether the frame has a target (its truth box is not empty).
+    pub fn has_target(&self) -> bool {
+        let [x0, y0, x1, y1] = self.truth;
+        !Roi::new(x0, y0, x1, y1).is_empty()
+    }
+
+    /// Whether the detector returned a (non-empty) box.
+    pub fn detected(&self) -> bool {
+        self.bbox
+            .is_some_and(|[x0, y0, x1, y1]| !Roi::new(x0, y0, x1, y1).is_empty())
+    }
+
+    /// A box on a frame without a target.
+    pub fn false_alarm(&self) -> bool {
+        !self.has_target() && self.detected()
+    }
 }
 
 /// How to run an evaluation.
@@ -263,7 +431,8 @@ pub fn score(
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
                 let mut out = Vec::with_capacity(options.methods.len());
                 if options.track == Track::Jitter {
-                    bank.set_prior(Some(jittered_prior(row.roi, &row.file)));
+                    // No target, nothing for a tracker to hand over.
+                    bank.set_prior(row.has_target().then(|| jittered_prior(row.roi, &row.file)));
                 }
                 for &m in &options.methods {
                     out.push(score_one(bank, m, &view, row, &path, options.repeat)?.0);
@@ -364,24 +533,36 @@ pub struct GroupStats {
     pub group: String,
     /// Group value.
     pub value: String,
-    /// Frames.
+    /// Frames (with and without a target).
     pub frames: usize,
-    /// Mean IoU.
+    /// Frames with a target (the IoU statistics are over these).
+    pub target_frames: usize,
+    /// Mean IoU over the frames with a target (0 when there are none).
     pub mean_iou: f64,
-    /// Median IoU.
+    /// Median IoU over the frames with a target (0 when there are none).
     pub median_iou: f64,
-    /// Fraction of frames with IoU ≥ 0.5.
+    /// Share of the frames with a target whose IoU ≥ [`HIT_IOU`].
     pub hit_rate: f64,
+    /// Share of the frames without a target where the detector returned a box
+    /// (0 when there are none).
+    pub false_alarm_rate: f64,
     /// Mean core time per frame, ms.
     pub mean_time_ms: f64,
     /// Median core time per frame, ms.
     pub median_time_ms: f64,
 }
 
-/// Statistics of a set of scores.
+/// Statistics of a set of scores, by the module's scoring definition.
 pub fn stats(method: &str, group: &str, value: &str, scores: &[&FrameScore]) -> GroupStats {
     let n = scores.len();
-    let mut ious: Vec<f64> = scores.iter().map(|s| f64::from(s.iou)).collect();
+    let mut ious: Vec<f64> = scores
+        .iter()
+        .filter(|s| s.has_target())
+        .map(|s| f64::from(s.iou))
+        .collect();
+    let targets = ious.len();
+    let empty = n - targets;
+    let alarms = scores.iter().filter(|s| s.false_alarm()).count();
     let mut times: Vec<f64> = scores.iter().map(|s| s.time_us * 1e-3).collect();
     let mean = |v: &[f64]| {
         if v.is_empty() {
@@ -395,11 +576,17 @@ pub fn stats(method: &str, group: &str, value: &str, scores: &[&FrameScore]) -> 
         group: group.into(),
         value: value.into(),
         frames: n,
+        target_frames: targets,
         mean_iou: mean(&ious),
-        hit_rate: if n == 0 {
+        hit_rate: if targets == 0 {
             0.0
         } else {
-            ious.iter().filter(|&&v| v >= 0.5).count() as f64 / n as f64
+            ious.iter().filter(|&&v| v >= f64::from(HIT_IOU)).count() as f64 / targets as f64
+        },
+        false_alarm_rate: if empty == 0 {
+            0.0
+        } else {
+            alarms as f64 / empty as f64
         },
         median_iou: median(&mut ious),
         mean_time_ms: mean(&times),
@@ -435,7 +622,7 @@ pub fn summarise(scores: &[FrameScore]) -> Vec<GroupStats> {
 /// The statistics as a Markdown table.
 pub fn markdown(stats: &[GroupStats]) -> String {
     let mut s = String::from(
-        "| method | group | frames | mean IoU | median IoU | IoU >= 0.5 | mean time [ms] | median time [ms] |\n|---|---|---|---|---|---|---|---|\n",
+        "| method | group | frames | mean IoU | median IoU | IoU >= 0.5 | target frames | false alarms | mean time [ms] | median time [ms] |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for g in stats {
         let group = if g.group == "all" {
@@ -443,13 +630,27 @@ pub fn markdown(stats: &[GroupStats]) -> String {
         } else {
             format!("{} = {}", g.group, g.value)
         };
+        // IoU columns need frames with a target, the false-alarm rate frames without.
+        let iou = |v: f64| {
+            if g.target_frames == 0 {
+                "–".to_string()
+            } else {
+                format!("{v:.3}")
+            }
+        };
+        let alarms = if g.frames == g.target_frames {
+            "–".to_string()
+        } else {
+            format!("{:.3}", g.false_alarm_rate)
+        };
         s.push_str(&format!(
-            "| {} | {group} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |\n",
+            "| {} | {group} | {} | {} | {} | {} | {} | {alarms} | {:.3} | {:.3} |\n",
             g.method,
             g.frames,
-            g.mean_iou,
-            g.median_iou,
-            g.hit_rate,
+            iou(g.mean_iou),
+            iou(g.median_iou),
+            iou(g.hit_rate),
+            g.target_frames,
             g.mean_time_ms,
             g.median_time_ms
         ));
@@ -470,24 +671,30 @@ pub fn write_reports(
     std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
     let mut csv =
         String::from("file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us\n");
+    // No target: empty truth fields, as in `truth.csv`.
     for s in scores {
         let b = s.bbox.map_or(",,,".to_string(), |b| {
             format!("{},{},{},{}", b[0], b[1], b[2], b[3])
         });
         let t = s.truth;
+        let t = if s.has_target() {
+            format!("{},{},{},{}", t[0], t[1], t[2], t[3])
+        } else {
+            ",,,".to_string()
+        };
         csv.push_str(&format!(
-            "{},{},{b},{},{},{},{},{:.4},{:.2}\n",
-            s.file, s.method, t[0], t[1], t[2], t[3], s.iou, s.time_us
+            "{},{},{b},{t},{:.4},{:.2}\n",
+            s.file, s.method, s.iou, s.time_us
         ));
     }
     let p = out.join("scores.csv");
     std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
     let mut csv = String::from(
-        "method,group,value,frames,mean_iou,median_iou,hit_rate,mean_time_ms,median_time_ms\n",
+        "method,group,value,frames,mean_iou,median_iou,hit_rate,mean_time_ms,median_time_ms,target_frames,false_alarm_rate\n",
     );
     for g in stats {
         csv.push_str(&format!(
-            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4}\n",
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{:.4}\n",
             g.method,
             g.group,
             g.value,
@@ -496,7 +703,9 @@ pub fn write_reports(
             g.median_iou,
             g.hit_rate,
             g.mean_time_ms,
-            g.median_time_ms
+            g.median_time_ms,
+            g.target_frames,
+            g.false_alarm_rate,
         ));
     }
     let p = out.join("summary.csv");
@@ -545,6 +754,34 @@ mod tests {
         let s1 = &all[1];
         assert_eq!((s1.value.as_str(), s1.frames), ("1", 2));
         assert!((s1.median_iou - 0.4).abs() < 1e-6);
+    }
+
+    #[test]
+    fn no_target_frames_by_hand() {
+        // Two target frames (IoU 0.8 hit, a miss with no box) and three without a
+        // target: one where the detector returned a box (a false alarm), two without.
+        let mut s = vec![score(0.8, 100.0, &[]), score(0.0, 100.0, &[])];
+        s[0].bbox = Some([0, 0, 1, 1]);
+        for alarm in [true, false, false] {
+            let mut f = score(0.0, 100.0, &[]);
+            f.truth = [0; 4];
+            f.bbox = alarm.then_some([3, 3, 9, 9]);
+            s.push(f);
+        }
+        let a = &summarise(&s)[0];
+        assert_eq!((a.frames, a.target_frames), (5, 2));
+        assert!((a.mean_iou - 0.4).abs() < 1e-6, "{}", a.mean_iou);
+        assert!((a.median_iou - 0.4).abs() < 1e-6);
+        assert!((a.hit_rate - 0.5).abs() < 1e-12);
+        assert!((a.false_alarm_rate - 1.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn scr_bins() {
+        assert_eq!(scr_bin(0.5), "<1");
+        assert_eq!(scr_bin(1.0), "1-3");
+        assert_eq!(scr_bin(9.99), "3-10");
+        assert_eq!(scr_bin(10.0), ">=10");
     }
 
     #[test]

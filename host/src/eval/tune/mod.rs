@@ -9,8 +9,10 @@
 //! method by steepest ascent on finer ladders of each coordinate (one ladder step up or
 //! down per coordinate, and the other box rule), at most
 //! [`SearchOptions::refine_steps`] moves each, and keeps the best end point. A
-//! candidate's score is its mean IoU; equal means (within 10⁻⁹) go to the clearly lower
-//! mean core time, else to the candidate scored first ([`Trial::beats`]). Every
+//! candidate's score is its mean IoU over the frames with a target (the scoring
+//! definition of [`crate::eval::scoring`]); equal means (within 10⁻⁹) go to the lower
+//! false-alarm rate on frames without a target, then to the clearly lower mean core
+//! time, else to the candidate scored first ([`Trial::beats`]). Every
 //! candidate scored, grid or refinement, is kept as a [`Trial`] (each once), so the
 //! trials double as the run-time-against-IoU scatter of a method.
 //!

@@ -51,6 +51,7 @@ fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
             groups: Vec::new(),
             range_m: None,
             bits: None,
+            signal_to_clutter: None,
         });
     }
     // Sets of different rules scored together score as each alone.
@@ -103,6 +104,7 @@ fn where_parses_and_filters() {
             .collect(),
         range_m: None,
         bits: None,
+        signal_to_clutter: None,
     };
     let rows = [
         row("a", &[("mode", "radiometry"), ("range", "close")]),

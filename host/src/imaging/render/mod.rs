@@ -49,9 +49,15 @@ use crate::world::geom::{Rotation, Vec3, norm, scale};
 use crate::world::scene::Camera;
 use crate::world::spacecraft::Mesh;
 
+mod clutter;
 mod earth;
 mod moon;
 mod target;
+
+pub use clutter::{
+    Clutter, QUANTISATION_SIGMA_DN, RING_MIN_WIDTH_PX, clutter_statistics, ring_width_px,
+    ring_window, signal_to_clutter,
+};
 
 use earth::render_earth;
 pub use moon::MoonView;
@@ -67,6 +73,9 @@ const NO_FACET: u32 = u32::MAX;
 pub const MIN_RANGE_NETD: f64 = 10.0;
 /// Coverage at or above which a pixel belongs to the target's mask and truth box.
 pub const MASK_COVERAGE: f32 = 0.5;
+/// Coverage *above* which a pixel belongs to the second truth box,
+/// [`Rendered::truth_quarter`] (the looser convention scored beside the ½ box).
+pub const QUARTER_COVERAGE: f32 = 0.25;
 
 /// The target as the camera sees it.
 #[derive(Debug, Clone, Copy)]
@@ -138,6 +147,8 @@ pub struct RenderStats {
     pub earth_ns: u64,
     /// DN map, noise and quantisation (the core's `expose_frame`), ns.
     pub expose_ns: u64,
+    /// The signal-to-clutter twin ([`signal_to_clutter`]; 0 when not computed), ns.
+    pub clutter_ns: u64,
     /// Pixels inside the target's projected bounds.
     pub target_region_px: usize,
     /// Pixels supersampled at the target's edges.
@@ -161,6 +172,9 @@ pub struct Rendered {
     pub coverage: Vec<f32>,
     /// Tight box of the pixels with coverage ≥ [`MASK_COVERAGE`] (empty when none).
     pub truth: Roi,
+    /// Tight box of the pixels with coverage > [`QUARTER_COVERAGE`] (⊇ `truth`; empty
+    /// when none).
+    pub truth_quarter: Roi,
     /// Fraction of the frame's pixels whose centre sees the Earth (not the target).
     pub earth_fraction: f64,
     /// Pixels whose centre sees the Moon (not the target, not the Earth).
@@ -171,6 +185,9 @@ pub struct Rendered {
     pub noise_sigma_dn: f32,
     /// Stage times and counts.
     pub stats: RenderStats,
+    /// Signal-to-clutter statistics; [`render`] leaves `None`, [`signal_to_clutter`]
+    /// computes them (an extra, windowed Earth pass) for callers that want them.
+    pub clutter: Option<Clutter>,
 }
 
 /// Why a frame could not be rendered.
@@ -235,9 +252,13 @@ impl Pinhole {
         scale(d, 1.0 / norm(d))
     }
 
-    /// Half the diagonal field of view, rad.
+    /// The largest angle between the boresight and a frame corner, rad (half the
+    /// diagonal field of view when the principal point is the frame centre; also right
+    /// for a window of the frame, whose principal point is off centre).
     fn half_diagonal_rad(&self) -> f64 {
-        (self.cx.hypot(self.cy) / self.f).atan()
+        let dx = self.cx.abs().max((self.w as f64 - self.cx).abs());
+        let dy = self.cy.abs().max((self.h as f64 - self.cy).abs());
+        (dx.hypot(dy) / self.f).atan()
     }
 }
 
@@ -372,6 +393,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     stats.expose_ns = t2.elapsed().as_nanos() as u64;
 
     let truth = mask_box(&coverage, cam.w);
+    let truth_quarter = coverage_box(&coverage, cam.w, |c| c > QUARTER_COVERAGE);
     Ok(Rendered {
         width: cam.w,
         height: cam.h,
@@ -379,11 +401,13 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
         signal,
         coverage,
         truth,
+        truth_quarter,
         earth_fraction: earth_px as f64 / n as f64,
         moon_px,
         mapping,
         noise_sigma_dn,
         stats,
+        clutter: None,
     })
 }
 
@@ -399,10 +423,15 @@ fn sample_point(x: usize, y: usize, s: usize) -> (f64, f64) {
 
 /// Tight box of the pixels whose coverage is at least [`MASK_COVERAGE`].
 pub fn mask_box(coverage: &[f32], width: usize) -> Roi {
+    coverage_box(coverage, width, |c| c >= MASK_COVERAGE)
+}
+
+/// Tight box of the pixels whose coverage `keep` accepts ([`Roi::EMPTY`] when none).
+pub fn coverage_box(coverage: &[f32], width: usize, keep: impl Fn(f32) -> bool) -> Roi {
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
     for (y, row) in coverage.chunks_exact(width).enumerate() {
         for (x, &c) in row.iter().enumerate() {
-            if c >= MASK_COVERAGE {
+            if keep(c) {
                 x0 = x0.min(x);
                 y0 = y0.min(y);
                 x1 = x1.max(x + 1);

@@ -124,6 +124,8 @@ pub fn figures(options: &PaperOptions, scores: &PaperScores) -> Result<Vec<PathB
         scores
             .iter()
             .filter(|s| group_of(s, "range") == Some("close"))
+            // IoU is scored over frames with a target (`eval::scoring`).
+            .filter(|s| s.has_target())
             .filter_map(|s| {
                 Some(plots::IouPoint {
                     method: s.method.to_string(),

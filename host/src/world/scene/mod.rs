@@ -43,7 +43,10 @@ mod tests;
 
 pub use camera::{Camera, ResponseName};
 pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
-pub use spec::{DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION, SceneSpec};
+pub use spec::{
+    DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION,
+    SceneSpec,
+};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -206,6 +209,12 @@ impl SceneFile {
         self.earth_model.validate()?;
         if self.scenes.is_empty() {
             return Err("no [[scene]] table: expected at least one scene kind".into());
+        }
+        let t = self.dataset.truth_coverage;
+        if !(t > 0.0 && t <= 1.0) {
+            return Err(format!(
+                "dataset.truth_coverage = {t}: expected a pixel coverage in (0, 1] (0.5: half covered)"
+            ));
         }
         if !(1..=1024).contains(&self.dataset.thermal_states) {
             return Err(format!(

@@ -110,6 +110,19 @@ pub struct DatasetSettings {
     /// state on the orbit, sampled at times along it; random-attitude scenes only,
     /// fixed attitudes keep the steady state).
     pub thermal: ThermalModel,
+    /// Target coverage at or above which a pixel belongs to the truth box `x0,y0,x1,y1`
+    /// of `truth.csv` (0 < value ≤ 1; default [`DEFAULT_TRUTH_COVERAGE`]). The box of the pixels
+    /// covered more than ¼ is written beside it whatever this is.
+    #[serde(skip_serializing_if = "is_half")]
+    pub truth_coverage: f64,
+}
+
+/// The default truth-box coverage: a pixel at least half covered by the target (the
+/// renderer's mask, `imaging::render::MASK_COVERAGE`, the paper's convention).
+pub const DEFAULT_TRUTH_COVERAGE: f64 = 0.5;
+
+fn is_half(v: &f64) -> bool {
+    *v == DEFAULT_TRUTH_COVERAGE
 }
 
 impl Default for DatasetSettings {
@@ -119,6 +132,7 @@ impl Default for DatasetSettings {
             seed: 1,
             thermal_states: 12,
             thermal: ThermalModel::Steady,
+            truth_coverage: DEFAULT_TRUTH_COVERAGE,
         }
     }
 }
@@ -213,6 +227,18 @@ pub struct SceneSpec {
     /// The Moon in the field of view with some probability (omitted: never).
     #[serde(default)]
     pub moon: Option<MoonSpec>,
+    /// Share of this kind's poses rendered without the target (0..=1, default 0): the
+    /// same camera, Earth and noise, nothing to detect (`target = "none"` in the labels,
+    /// empty truth box). ⌈share × poses⌉ poses, picked by a permutation seeded from the
+    /// dataset seed and the kind's index, so they mix with every material and
+    /// illumination the poses cycle through; the other poses are unchanged. 1: a kind of
+    /// target-less frames only.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub no_target_fraction: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn one() -> usize {
@@ -388,6 +414,12 @@ impl SceneSpec {
                     m.probability
                 ));
             }
+        }
+        if !(0.0..=1.0).contains(&self.no_target_fraction) {
+            return Err(format!(
+                "{at}.no_target_fraction = {}: expected a share in 0..=1",
+                self.no_target_fraction
+            ));
         }
         Ok(())
     }

@@ -88,3 +88,26 @@ fn camera_response_is_hayabusa2_by_default_and_selectable() {
     assert!(e.to_string().contains("x.toml:2:"), "{e}");
     assert!(e.to_string().contains("hayabusa2"), "{e}");
 }
+
+#[test]
+fn no_target_share_and_truth_coverage_are_checked() {
+    let f = SceneFile::parse("[[scene]]\nrange_m = 20.0\nno_target_fraction = 0.1\n", "x").unwrap();
+    assert_eq!(f.scenes[0].no_target_fraction, 0.1);
+    assert_eq!(f.dataset.truth_coverage, DEFAULT_TRUTH_COVERAGE);
+    let e =
+        SceneFile::parse("[[scene]]\nrange_m = 20.0\nno_target_fraction = 1.5\n", "x").unwrap_err();
+    assert!(e.to_string().contains("scene[0].no_target_fraction"), "{e}");
+    let e = SceneFile::parse(
+        "[dataset]\ntruth_coverage = 0.0\n[[scene]]\nrange_m = 20.0\n",
+        "x",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("dataset.truth_coverage"), "{e}");
+    // Off by default, and not printed then: the presets' TOML stays as it was.
+    for (name, _, _) in PRESETS {
+        let p = SceneFile::preset(name).unwrap();
+        assert!(p.scenes.iter().all(|s| s.no_target_fraction == 0.0));
+        let text = toml::to_string(&p).unwrap();
+        assert!(!text.contains("no_target_fraction") && !text.contains("truth_coverage"));
+    }
+}

@@ -1,0 +1,257 @@
+//! Signal-to-clutter ratio of a rendered frame: how far the target stands out of the
+//! background it sits on, before noise.
+//!
+//! - **Background twin**: the frame rendered without the target, noise-free, over the
+//!   truth box and its ring only (the Earth pass on a window of the camera; deep space
+//!   is 0 signal). Outside the target's coverage it equals the frame's own noise-free
+//!   signal; under the target it is the Earth (or space) the target hides.
+//! - **Target contrast**, DN: |mean over the target mask (coverage ≥ [`MASK_COVERAGE`])
+//!   of (frame signal − twin signal)| × the frame's DN gain (noise-free, unquantised).
+//! - **Clutter σ**, DN: the standard deviation of the twin over the ring: the pixels
+//!   within [`ring_width_px`] of the truth box (Chebyshev distance, outside the box,
+//!   cut to the frame), × the DN gain.
+//! - **SCR** = contrast / max(clutter σ, noise σ, [`QUANTISATION_SIGMA_DN`]). The floor:
+//!   a background flatter than the camera's own noise (deep space, a uniform cloud
+//!   deck) is not what hides the target, and the floor keeps deep space finite; the
+//!   quantisation σ is the floor of a noise-free render.
+//!
+//! The window's Earth pass supersamples the limb where neighbours *inside the window*
+//! differ, so a limb pixel on the window's edge may get its centre ray only (a small
+//! difference in a statistic over hundreds of pixels). Cost: one Earth ray per pixel
+//! of the window (plus its limb), measured in `docs/scenes.md`.
+
+use tirroi_core::Roi;
+
+use super::earth::render_earth;
+use super::target::Range;
+use super::{MASK_COVERAGE, Pinhole, RenderError, RenderInput, RenderStats, Rendered};
+
+/// Narrowest ring around the truth box, px: enough pixels for a standard deviation of
+/// a small target's surroundings.
+pub const RING_MIN_WIDTH_PX: usize = 4;
+
+/// The σ of uniform quantisation to whole DN, 1/√12 DN: the clutter floor of a
+/// noise-free frame.
+pub const QUANTISATION_SIGMA_DN: f64 = 0.288_675_134_594_812_9;
+
+/// The target's standing against its background ([module docs](self)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clutter {
+    /// |Mean target − background| over the mask, DN (noise-free).
+    pub target_contrast_dn: f64,
+    /// Standard deviation of the background twin over the ring, DN (noise-free).
+    pub clutter_sigma_dn: f64,
+    /// Contrast over max(clutter σ, noise σ, [`QUANTISATION_SIGMA_DN`]).
+    pub signal_to_clutter: f64,
+}
+
+/// Width of the ring around a truth box, px: max([`RING_MIN_WIDTH_PX`], half the box's
+/// longer side, rounded up).
+pub fn ring_width_px(truth: Roi) -> usize {
+    let side = usize::from(truth.width().max(truth.height()));
+    RING_MIN_WIDTH_PX.max(side.div_ceil(2))
+}
+
+/// The truth box grown by the ring width on every side, cut to the frame.
+pub fn ring_window(truth: Roi, width: usize, height: usize) -> Roi {
+    let b = ring_width_px(truth);
+    let grow = |v: u16, d: usize| usize::from(v).saturating_sub(d);
+    let x0 = grow(truth.x0, b);
+    let y0 = grow(truth.y0, b);
+    let x1 = (usize::from(truth.x1) + b).min(width);
+    let y1 = (usize::from(truth.y1) + b).min(height);
+    Roi::new(x0 as u16, y0 as u16, x1 as u16, y1 as u16)
+}
+
+/// The statistics of [`Clutter`] from full-frame arrays: `signal` (with the target,
+/// noise-free), `background` (the twin), `coverage`, all `width` wide; `truth` the ½
+/// box; `gain_dn` DN per signal unit; `noise_sigma_dn` the frame's noise σ. `None`
+/// when the truth box is empty.
+#[allow(clippy::too_many_arguments)]
+pub fn clutter_statistics(
+    signal: &[f32],
+    background: &[f32],
+    coverage: &[f32],
+    width: usize,
+    truth: Roi,
+    gain_dn: f64,
+    noise_sigma_dn: f64,
+) -> Option<Clutter> {
+    if truth.is_empty() || width == 0 {
+        return None;
+    }
+    let height = signal.len() / width;
+    let window = ring_window(truth, width, height);
+    let (mut diff, mut n_mask) = (0f64, 0usize);
+    let (mut sum, mut sum2, mut n_ring) = (0f64, 0f64, 0usize);
+    for y in usize::from(window.y0)..usize::from(window.y1) {
+        for x in usize::from(window.x0)..usize::from(window.x1) {
+            let i = y * width + x;
+            let b = f64::from(background[i]);
+            if coverage[i] >= MASK_COVERAGE {
+                diff += f64::from(signal[i]) - b;
+                n_mask += 1;
+            }
+            let inside = x >= usize::from(truth.x0)
+                && x < usize::from(truth.x1)
+                && y >= usize::from(truth.y0)
+                && y < usize::from(truth.y1);
+            if !inside {
+                sum += b;
+                sum2 += b * b;
+                n_ring += 1;
+            }
+        }
+    }
+    if n_mask == 0 {
+        return None;
+    }
+    let contrast = (diff / n_mask as f64 * gain_dn).abs();
+    let sigma = if n_ring == 0 {
+        0.0
+    } else {
+        let m = sum / n_ring as f64;
+        (sum2 / n_ring as f64 - m * m).max(0.0).sqrt() * gain_dn.abs()
+    };
+    let floor = sigma.max(noise_sigma_dn).max(QUANTISATION_SIGMA_DN);
+    Some(Clutter {
+        target_contrast_dn: contrast,
+        clutter_sigma_dn: sigma,
+        signal_to_clutter: contrast / floor,
+    })
+}
+
+/// The [`Clutter`] of `frame`, rendered from `input` (the same input, target included);
+/// `None` when the frame has no target pixel at coverage ≥ ½.
+///
+/// # Errors
+/// [`RenderError`] as the Earth pass of [`super::render`].
+pub fn signal_to_clutter(
+    input: &RenderInput<'_>,
+    frame: &Rendered,
+) -> Result<Option<Clutter>, RenderError> {
+    if input.target.is_none() || frame.truth.is_empty() {
+        return Ok(None);
+    }
+    let (w, h) = (frame.width, frame.height);
+    let window = ring_window(frame.truth, w, h);
+    let mut background = vec![0f32; w * h];
+    if let Some(earth) = &input.earth {
+        let full = Pinhole::new(input.camera);
+        let (wx, wy) = (usize::from(window.x0), usize::from(window.y0));
+        let (ww, wh) = (usize::from(window.width()), usize::from(window.height()));
+        let crop = Pinhole {
+            f: full.f,
+            cx: full.cx - wx as f64,
+            cy: full.cy - wy as f64,
+            w: ww,
+            h: wh,
+        };
+        let none = vec![0f32; ww * wh];
+        let mut twin = vec![0f32; ww * wh];
+        render_earth(
+            &crop,
+            earth,
+            input.readout,
+            &none,
+            &mut twin,
+            &mut Range::default(),
+            &mut RenderStats::default(),
+        )?;
+        for (row, line) in twin.chunks_exact(ww).enumerate() {
+            let at = (wy + row) * w + wx;
+            background[at..at + ww].copy_from_slice(line);
+        }
+    }
+    Ok(clutter_statistics(
+        &frame.signal,
+        &background,
+        &frame.coverage,
+        w,
+        frame.truth,
+        frame.mapping.gain_dn(),
+        f64::from(frame.noise_sigma_dn),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A uniform disc of contrast `c` (coverage 1 inside radius `r`, 0 outside) over a
+    /// checkerboard background `b0 ± a`.
+    fn disc_on_checkerboard(
+        w: usize,
+        h: usize,
+        centre: (f64, f64),
+        r: f64,
+        c: f32,
+        b0: f32,
+        a: f32,
+    ) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let (mut sig, mut bg, mut cov) = (vec![0f32; w * h], vec![0f32; w * h], vec![0f32; w * h]);
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                bg[i] = if (x + y) % 2 == 0 { b0 + a } else { b0 - a };
+                let inside = (x as f64 + 0.5 - centre.0).hypot(y as f64 + 0.5 - centre.1) < r;
+                cov[i] = if inside { 1.0 } else { 0.0 };
+                sig[i] = if inside { bg[i] + c } else { bg[i] };
+            }
+        }
+        (sig, bg, cov)
+    }
+
+    #[test]
+    fn uniform_disc_on_a_checkerboard_by_hand() {
+        // Disc of radius 5 px at (20, 20) in a 40 × 40 frame: its ≥ ½ box is the 10 × 10
+        // square [15, 25)², the ring 5 px wide (half the side): the 20 × 20 square
+        // [10, 30)² less the box, 300 pixels, 150 of each checkerboard colour, so the
+        // ring's σ is exactly a. Contrast c; gain g scales both.
+        let (w, h) = (40, 40);
+        let (c, b0, a, g) = (6.0f32, 100.0f32, 2.0f32, 3.0f64);
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, a);
+        let truth = super::super::mask_box(&cov, w);
+        assert_eq!(truth, Roi::new(15, 15, 25, 25));
+        assert_eq!(ring_width_px(truth), 5);
+        assert_eq!(ring_window(truth, w, h), Roi::new(10, 10, 30, 30));
+        let got = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-9 * y.abs().max(1.0);
+        assert!(close(got.target_contrast_dn, f64::from(c) * g), "{got:?}");
+        assert!(close(got.clutter_sigma_dn, f64::from(a) * g), "{got:?}");
+        assert!(close(got.signal_to_clutter, f64::from(c / a)), "{got:?}");
+        // A noise σ above the clutter becomes the denominator.
+        let noisy = clutter_statistics(&sig, &bg, &cov, w, truth, g, 60.0).unwrap();
+        assert!(close(noisy.signal_to_clutter, f64::from(c) * g / 60.0));
+        // A flat background, no noise: the quantisation floor 1/√12 DN.
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, 0.0);
+        let flat = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.0).unwrap();
+        assert_eq!(flat.clutter_sigma_dn, 0.0);
+        assert!(close(
+            flat.signal_to_clutter,
+            f64::from(c) * g * 12f64.sqrt()
+        ));
+        // A darker target: the contrast's magnitude.
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, -c, b0, a);
+        let dark = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        assert!(close(dark.target_contrast_dn, f64::from(c) * g));
+    }
+
+    #[test]
+    fn ring_is_cut_to_the_frame_and_empty_truth_gives_none() {
+        let truth = Roi::new(0, 0, 3, 2);
+        assert_eq!(ring_width_px(truth), RING_MIN_WIDTH_PX);
+        assert_eq!(ring_window(truth, 5, 50), Roi::new(0, 0, 5, 6));
+        let z = vec![0f32; 16];
+        assert_eq!(
+            clutter_statistics(&z, &z, &z, 4, Roi::EMPTY, 1.0, 0.0),
+            None
+        );
+        assert_eq!(QUANTISATION_SIGMA_DN, 1.0 / 12f64.sqrt());
+        // The scene file's default truth box is the renderer's mask.
+        assert_eq!(
+            crate::world::scene::DEFAULT_TRUTH_COVERAGE,
+            f64::from(MASK_COVERAGE)
+        );
+    }
+}
