@@ -65,7 +65,10 @@ pub struct FitsImage {
 impl FitsImage {
     /// The value of a header keyword (exact, upper-case FITS name), if present.
     pub fn keyword(&self, name: &str) -> Option<&FitsValue> {
-        self.keywords.iter().find(|(k, _)| k == name).map(|(_, v)| v)
+        self.keywords
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v)
     }
 
     /// A numeric header keyword, if present and numeric.
@@ -117,7 +120,7 @@ pub fn parse_fits(bytes: &[u8]) -> Result<FitsImage, String> {
         let hdu = match hdus.next() {
             None => {
                 return Err(
-                    "no image HDU with NAXIS = 2: expected a two-dimensional image".to_string()
+                    "no image HDU with NAXIS = 2: expected a two-dimensional image".to_string(),
                 );
             }
             Some(Err(e)) => return Err(format!("HDU {index}: not valid FITS: {e}")),

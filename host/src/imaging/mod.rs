@@ -3,6 +3,7 @@
 //! - [`render`]: the physical renderer (target and Earth radiance → DN, noise);
 //! - [`fits`]: reading FITS images (BSCALE/BZERO applied, size checked first);
 //! - [`fixture`]: procedural test frames with known boxes (no physics);
+//! - [`signature`]: the real camera's own signature (fit on a real frame, realisations);
 //! - [`image_io`]: reading and writing 8/16-bit PNG/TIFF frames;
 //! - [`overlay`]: frames drawn with boxes on them (previews, demo and paper figures).
 //!
@@ -13,3 +14,4 @@ pub mod fixture;
 pub mod image_io;
 pub mod overlay;
 pub mod render;
+pub mod signature;
