@@ -5,6 +5,7 @@
 //! - [`fixture`]: procedural test frames with known boxes (no physics);
 //! - [`signature`]: the real camera's own signature (fit on a real frame, realisations);
 //! - [`image_io`]: reading and writing 8/16-bit PNG/TIFF frames;
+//! - [`psf`]: the optics' point-spread function (Airy at the aperture × pixel footprint);
 //! - [`overlay`]: frames drawn with boxes on them (previews, demo and paper figures).
 //!
 //! Imports the [`world`](crate::world) stage, never a later one.
@@ -13,5 +14,6 @@ pub mod fits;
 pub mod fixture;
 pub mod image_io;
 pub mod overlay;
+pub mod psf;
 pub mod render;
 pub mod signature;
