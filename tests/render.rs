@@ -5,7 +5,9 @@
 use tirroi::core::Roi;
 use tirroi::core::sensor::flux::SENSOR_AREA_M2;
 use tirroi::core::sensor::{BandLut, BandRadiance, DetectionScale, DnMapping};
-use tirroi::host::imaging::render::{EarthView, Readout, RenderInput, TargetView, render};
+use tirroi::host::imaging::render::{
+    EarthView, Readout, RenderInput, SensorEffects, TargetView, render,
+};
 use tirroi::host::world::earth::{EarthMap, OlrGrid, flux_to_temperature_k};
 use tirroi::host::world::geom::{Rotation, Vec3};
 use tirroi::host::world::scene::Camera;
@@ -34,6 +36,7 @@ fn input<'a>(
         noise_seed: None,
         band: &band.0,
         lut: &band.1,
+        sensor: SensorEffects::NONE,
     }
 }
 

@@ -6,16 +6,22 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
+use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale, DnMapping};
 
 use super::DatasetError;
 use super::plan::{ImagePlan, ThermalKey};
-use crate::imaging::render::{self, EarthView, Readout, RenderInput, Rendered, TargetView};
+use crate::imaging::psf::OpticsPsf;
+use crate::imaging::render::{
+    self, EarthView, Readout, RenderInput, Rendered, SensorEffects, TargetView,
+};
+use crate::imaging::signature::Calibration;
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::earth::{EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
-use crate::world::scene::{EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::scene::{
+    EarthSource, Illumination, RadiometryReadout, SceneFile, SignatureKind, TargetModel,
+};
 use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
 };
@@ -40,6 +46,48 @@ pub struct Library {
     pub(super) earth: HashMap<(Illumination, usize), Arc<EarthMap>>,
     /// Seconds spent building the library: meshes, thermal solutions, Earth maps.
     pub build_s: [f64; 3],
+    /// The optics PSF when `[camera] optics_psf` is on.
+    pub psf: Option<OpticsPsf>,
+    /// The signature calibration when `[camera] signature` is not "none" (a new
+    /// realisation per image).
+    pub signature: Option<Calibration>,
+    /// The fixed-gain radiometry map when `[camera] readout = "fixed-gain"`.
+    pub fixed_gain: Option<DnMapping>,
+}
+
+/// Salt of the per-image signature seed (so it is independent of the noise seed).
+const SIGNATURE_SEED_SALT: u64 = 0x5167_0000_0000_0015;
+
+/// The sensor-effect pieces of a camera: PSF, signature calibration, fixed-gain map.
+type SensorPieces = (Option<OpticsPsf>, Option<Calibration>, Option<DnMapping>);
+
+fn sensor_pieces(file: &SceneFile) -> Result<SensorPieces, DatasetError> {
+    let cam = &file.camera;
+    let err = |e: String| DatasetError(format!("camera: {e}"));
+    let psf = if cam.optics_psf {
+        Some(OpticsPsf::hayabusa2_tir(cam.pixel_pitch_um).map_err(err)?)
+    } else {
+        None
+    };
+    let needs_cal =
+        cam.signature != SignatureKind::None || cam.readout == RadiometryReadout::FixedGain;
+    let cal = if needs_cal {
+        Some(Calibration::hayabusa2_tir().map_err(err)?)
+    } else {
+        None
+    };
+    let fixed = match (&cal, cam.readout) {
+        (Some(c), RadiometryReadout::FixedGain) => {
+            Some(c.fixed_gain_mapping(cam.bits).map_err(err)?)
+        }
+        _ => None,
+    };
+    let signature = if cam.signature == SignatureKind::Hayabusa2Dark {
+        cal
+    } else {
+        None
+    };
+    Ok((psf, signature, fixed))
 }
 
 fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
@@ -181,9 +229,13 @@ impl Library {
             })
             .collect::<Result<_, DatasetError>>()?;
         let t3 = Instant::now();
+        let (psf, signature, fixed_gain) = sensor_pieces(file)?;
         Ok(Library {
             band,
             lut,
+            psf,
+            signature,
+            fixed_gain,
             meshes,
             thermal,
             earth,
@@ -223,6 +275,10 @@ impl Library {
         } else {
             None
         };
+        let realisation = self.signature.as_ref().map(|c| {
+            let seed = splitmix64(file.dataset.seed ^ SIGNATURE_SEED_SALT ^ plan.index as u64);
+            c.realise(file.camera.width, file.camera.height, seed)
+        });
         let input = RenderInput {
             camera: &file.camera,
             readout: match plan.scale {
@@ -242,6 +298,11 @@ impl Library {
             noise_seed: plan.noise_seed,
             band: &self.band,
             lut: &self.lut,
+            sensor: SensorEffects {
+                psf: self.psf.as_ref(),
+                signature: realisation.as_ref(),
+                fixed_gain: self.fixed_gain,
+            },
         };
         let frame = render::render(&input)
             .map_err(|e| DatasetError(format!("image {}: {e}", plan.index)))?;

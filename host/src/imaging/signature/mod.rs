@@ -33,6 +33,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Poisson, StandardNormal};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
+use tirroi_core::sensor::DnMapping;
 
 pub mod fit;
 
@@ -64,6 +65,14 @@ pub const CELSIUS_TO_KELVIN: f64 = 273.15;
 /// The effective (active) area of a TIR L1 frame, [x0, y0, width, height], px: columns
 /// 16–343 and rows 6–253, 0-based (the reference README, HEAT's `image[y+6][x+16]`).
 pub const TIR_EFFECTIVE_AREA_PX: [usize; 4] = [16, 6, 328, 248];
+
+/// Pedestal of the fixed-gain radiometry readout, DN at 14 bits: the DN of F = 0 (deep
+/// space). The signature spans −56…+150 DN about it on the calibration frame (smooth
+/// shading −56…+90, hot pixels up to +272 DN, dead down to −17 DN about the local
+/// level), so deep space's lowest pixel sits near 960 DN: 30 σ of the frame's spatial
+/// σ (32 DN) and about 380 σ of the rendered noise (2.5 DN) above 0 DN, leaving
+/// 15 359 DN (1 217 W m⁻² sr⁻¹, far above a 460 K scene's 190) of headroom.
+pub const FIXED_GAIN_PEDESTAL_DN: f64 = 1024.0;
 
 /// Standard error of a median over that of a mean for Gaussian data, √(π/2).
 const MEDIAN_EFFICIENCY: f64 = 1.253_314_137_315_500_3;
@@ -154,6 +163,18 @@ impl Calibration {
              # Model and derivations: docs/camera-model.md (\"The sensor's own signature\").\n\n{body}",
             self.source.file
         ))
+    }
+
+    /// The fixed-gain radiometry readout of this camera: DN = a·F + b with
+    /// a = g/π (g = [`GainCalibration::dn_per_w_m2_sr`], the real camera's DN per band
+    /// radiance, taken as the 14-bit DN) and b = [`FIXED_GAIN_PEDESTAL_DN`], both scaled
+    /// by 2^(bits − 14).
+    ///
+    /// # Errors
+    /// A message for a bit depth outside 1..=16.
+    pub fn fixed_gain_mapping(&self, bits: u8) -> Result<DnMapping, String> {
+        DnMapping::radiometry_fixed_gain(self.gain.dn_per_w_m2_sr, FIXED_GAIN_PEDESTAL_DN, bits)
+            .map_err(|e| format!("fixed-gain readout: {e}"))
     }
 
     /// Fixed per-pixel residual σ, DN: the fitted σ less the temporal noise in

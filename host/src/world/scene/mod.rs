@@ -35,7 +35,7 @@ mod spec;
 #[cfg(test)]
 mod tests;
 
-pub use camera::Camera;
+pub use camera::{Camera, RadiometryReadout, SignatureKind};
 pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
 pub use spec::{DatasetSettings, EarthModel, EarthSource, SceneSpec};
 
