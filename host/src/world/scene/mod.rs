@@ -23,6 +23,15 @@
 //! illumination = ["sunlit", "eclipse"]
 //! earth_off_boresight_deg = 30.0
 //! ```
+//!
+//! Opt-in camera realism (all off by default, which keeps today's frames):
+//!
+//! ```toml
+//! [camera]
+//! signature = "hayabusa2-dark"  # the real TIR's shading, column/row pattern, hot pixels
+//! optics_psf = true             # Airy (F/1.4) over the pixel footprint, before the DN map
+//! readout = "fixed-gain"        # radiometry: DN = a·F + b (real gain, 1024 DN pedestal)
+//! ```
 
 use std::fmt;
 use std::path::Path;
