@@ -245,11 +245,9 @@ mod tests {
         let s: f64 = psf.kernel.iter().flatten().map(|&k| f64::from(k)).sum();
         assert!((s - 1.0).abs() < 1e-6, "{s}");
         let k = &psf.kernel;
-        for i in 0..PSF_SIDE_PX {
-            for j in 0..PSF_SIDE_PX {
-                assert!((k[i][j] - k[j][i]).abs() < 1e-6);
-                assert!((k[i][j] - k[PSF_SIDE_PX - 1 - i][j]).abs() < 1e-6);
-            }
+        for (i, j) in (0..PSF_SIDE_PX).flat_map(|i| (0..PSF_SIDE_PX).map(move |j| (i, j))) {
+            assert!((k[i][j] - k[j][i]).abs() < 1e-6);
+            assert!((k[i][j] - k[PSF_SIDE_PX - 1 - i][j]).abs() < 1e-6);
         }
         // The 5 × 5 square (half side 92.5 µm) lies between the inscribed and the
         // circumscribed discs: its energy between their band-averaged encircled energies.

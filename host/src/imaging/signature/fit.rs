@@ -278,16 +278,19 @@ fn fit_poly(frame: &[f64], w: usize, h: usize, keep: &[bool]) -> Result<Vec<f64>
     for y in 0..h {
         let yp = powers(norm_coord(y as f64, h));
         let (mut sx, mut bx) = ([0.0f64; P], [0.0f64; P]);
-        for x in 0..w {
-            let i = y * w + x;
-            if !keep[i] {
+        let rows = xp
+            .iter()
+            .zip(&keep[y * w..(y + 1) * w])
+            .zip(&frame[y * w..(y + 1) * w]);
+        for ((px, &kept), &v) in rows {
+            if !kept {
                 continue;
             }
-            for p in 0..P {
-                sx[p] += xp[x][p];
+            for (s, &t) in sx.iter_mut().zip(px) {
+                *s += t;
             }
-            for p in 0..=SHADING_DEGREE {
-                bx[p] += xp[x][p] * frame[i];
+            for (b, &t) in bx.iter_mut().zip(px).take(SHADING_DEGREE + 1) {
+                *b += t * v;
             }
         }
         for p in 0..P {
@@ -372,8 +375,9 @@ fn solve(
         b.swap(col, piv);
         for r in col + 1..n {
             let f = a[r][col] / a[col][col];
-            for c in col..n {
-                a[r][c] -= f * a[col][c];
+            let pivot_row = a[col];
+            for (x, &p) in a[r].iter_mut().zip(&pivot_row).skip(col) {
+                *x -= f * p;
             }
             b[r] -= f * b[col];
         }

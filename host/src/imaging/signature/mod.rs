@@ -297,19 +297,15 @@ impl Calibration {
         let xs: Vec<f64> = (0..width)
             .map(|x| norm_coord(x as f64 - dx, width))
             .collect();
-        for y in 0..height {
+        for (y, &row_y) in row.iter().enumerate() {
             let yn = norm_coord(y as f64 - dy, height);
             let rc = row_coefficients(c, yn);
-            for x in 0..width {
-                let xn = xs[x];
-                let mut s = 0.0;
-                for k in (0..=SHADING_DEGREE).rev() {
-                    s = s * xn + rc[k];
-                }
+            for (x, (&xn, &col_x)) in xs.iter().zip(&col).enumerate() {
+                let s = rc.iter().rev().fold(0.0, |s, &k| s * xn + k);
                 let p: f64 = sp * rng.sample::<f64, _>(StandardNormal);
                 let i = y * width + x;
                 pixel[i] = p;
-                offset[i] = alpha * (s - mean) + col[x] + row[y] + p;
+                offset[i] = alpha * (s - mean) + col_x + row_y + p;
             }
         }
         // Outliers: a Poisson count per kind with the fitted mean scaled to the area.
