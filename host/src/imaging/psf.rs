@@ -242,6 +242,10 @@ mod tests {
     #[test]
     fn kernel_sums_to_one_is_symmetric_and_captures_the_encircled_energy() {
         let psf = OpticsPsf::hayabusa2_tir(37.0).unwrap();
+        eprintln!(
+            "F/{} kernel (captured {:.4}): {:?}",
+            psf.f_number, psf.captured_energy, psf.kernel
+        );
         let s: f64 = psf.kernel.iter().flatten().map(|&k| f64::from(k)).sum();
         assert!((s - 1.0).abs() < 1e-6, "{s}");
         let k = &psf.kernel;
