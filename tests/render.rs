@@ -5,7 +5,9 @@
 use tirroi::core::Roi;
 use tirroi::core::sensor::flux::SENSOR_AREA_M2;
 use tirroi::core::sensor::{BandLut, BandRadiance, DetectionScale, DnMapping};
-use tirroi::host::imaging::render::{EarthView, Readout, RenderInput, TargetView, render};
+use tirroi::host::imaging::render::{
+    EarthView, Readout, RenderInput, SensorEffects, TargetView, render,
+};
 use tirroi::host::world::earth::{EarthMap, OlrGrid, flux_to_temperature_k};
 use tirroi::host::world::geom::{Rotation, Vec3};
 use tirroi::host::world::scene::Camera;
@@ -36,6 +38,7 @@ fn input<'a>(
         lut: &band.1,
         gain_factor: 1.0,
         moon: None,
+        sensor: SensorEffects::NONE,
     }
 }
 
@@ -398,4 +401,47 @@ fn a_uniform_radiometry_scene_keeps_a_usable_range_and_noise() {
         "{}",
         out.noise_sigma_dn
     );
+}
+
+/// Deep space with the real camera's signature and the fixed-gain readout: the frame
+/// carries the calibration frame's shading and column pattern (within 10 %, measured by
+/// the same fit), sits on the pedestal, and the PSF costs nothing to a uniform scene.
+#[test]
+fn deep_space_carries_the_real_camera_signature_on_the_pedestal() {
+    use tirroi::host::imaging::psf::OpticsPsf;
+    use tirroi::host::imaging::signature::fit::fit_frame;
+    use tirroi::host::imaging::signature::{Calibration, FIXED_GAIN_PEDESTAL_DN};
+    let camera = Camera::default();
+    let b = band();
+    let cal = Calibration::hayabusa2_tir().unwrap();
+    let psf = OpticsPsf::hayabusa2_tir(camera.pixel_pitch_um).unwrap();
+    let fixed = cal.fixed_gain();
+    for seed in [1u64, 2, 3] {
+        let sig = cal.realise(camera.width, camera.height, seed);
+        let mut inp = input(&camera, Readout::Radiometry, None, None, &b);
+        inp.sensor = SensorEffects {
+            psf: Some(&psf),
+            signature: Some(&sig),
+            fixed_gain: Some(fixed),
+        };
+        let out = render(&inp).unwrap();
+        let dn: Vec<f64> = out.dn.iter().map(|&d| f64::from(d)).collect();
+        let (fit, _) = fit_frame(&dn, camera.width, camera.height).unwrap();
+        let amp = fit.shading.amplitude_dn / cal.fit.shading.amplitude_dn - 1.0;
+        let col = fit.columns.sigma_dn / cal.fit.columns.sigma_dn - 1.0;
+        assert!(
+            amp.abs() < 0.1 && col.abs() < 0.1,
+            "seed {seed}: {amp} {col}"
+        );
+        // Deep space about the pedestal: the mean within a few DN, nothing near 0.
+        assert!((fit.shading.mean_dn - FIXED_GAIN_PEDESTAL_DN).abs() < 5.0);
+        assert!(
+            *out.dn.iter().min().unwrap() > 900,
+            "{:?}",
+            out.dn.iter().min()
+        );
+    }
+    // Without sensor effects the frame is the flat auto-ranged deep space it was.
+    let plain = render(&input(&camera, Readout::Radiometry, None, None, &b)).unwrap();
+    assert!(plain.dn.iter().all(|&d| d == plain.dn[0]));
 }

@@ -14,7 +14,7 @@ use tirroi::host::dataset::{WriteOptions, keep_in_view, plan, write_dataset};
 use tirroi::host::eval::scoring::{read_row_frame, read_truth};
 use tirroi::host::imaging::image_io::read_frame;
 use tirroi::host::imaging::render::{
-    EarthView, MoonView, Readout, RenderInput, Rendered, TargetView, render,
+    EarthView, MoonView, Readout, RenderInput, Rendered, SensorEffects, TargetView, render,
 };
 use tirroi::host::world::earth::{EarthMap, OlrGrid};
 use tirroi::host::world::geom::{Rotation, Vec3, normalize};
@@ -96,6 +96,7 @@ impl<'a> Scene<'a> {
             lut: &b.1,
             gain_factor: self.gain,
             moon: self.moon,
+            sensor: SensorEffects::NONE,
         })
         .unwrap()
     }
@@ -453,6 +454,7 @@ fn a_sub_pixel_boom_covers_its_projected_area() {
             lut: &b.1,
             gain_factor: 1.0,
             moon: None,
+            sensor: SensorEffects::NONE,
         })
         .unwrap();
         let f = camera.focal_px();

@@ -19,6 +19,9 @@ use crate::frame::MAX_BIT_DEPTH;
 /// 276.2 K) gives 2.07·10⁻¹⁷ W m⁻²: the same order (core/tests/sensor_scales.rs).
 pub const EARTH_MAX_FLUX_TABLE5_W_M2: f64 = 3e-17;
 
+/// Bit depth at which a fixed radiometry gain is given (the frames' default, 14 bits).
+pub const FIXED_GAIN_REFERENCE_BITS: u8 = 14;
+
 /// The fixed radiance scales of detection mode (paper Table 5): q_min = 0 and q_max a
 /// multiple of the Earth's maximum detected flux.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,6 +113,40 @@ impl DnMapping {
         let full = full_scale(bits);
         let gain = full / span;
         Self::new(gain, -gain * f_min_w_m2, bits)
+    }
+
+    /// Radiometry mode with a fixed gain instead of Eq. 17's auto range: a real
+    /// camera's read-out, DN = a·F + b with a = `dn_per_w_m2_sr`/π (F = π·L, Eq. 6) at
+    /// [`FIXED_GAIN_REFERENCE_BITS`] bits, scaled by 2^(bits − 14) for another depth,
+    /// and the pedestal b = `pedestal_dn` (DN of F = 0, likewise scaled) that keeps
+    /// deep space above 0 DN.
+    ///
+    /// # Errors
+    /// [`SensorError`] for a gain that is not finite and > 0, a pedestal that is not
+    /// finite, or a bit depth outside 1..=16.
+    pub fn radiometry_fixed_gain(
+        dn_per_w_m2_sr: f64,
+        pedestal_dn: f64,
+        bits: u8,
+    ) -> Result<Self, SensorError> {
+        check_positive("dn_per_w_m2_sr", dn_per_w_m2_sr)?;
+        check_range(
+            "pedestal_dn",
+            pedestal_dn,
+            f64::MIN,
+            f64::MAX,
+            "a finite DN",
+        )?;
+        let depth = full_scale(bits);
+        if depth == 0.0 {
+            return Self::new(1.0, 0.0, bits);
+        }
+        let k = libm::exp2(f64::from(bits) - f64::from(FIXED_GAIN_REFERENCE_BITS));
+        Self::new(
+            k * dn_per_w_m2_sr / core::f64::consts::PI,
+            k * pedestal_dn,
+            bits,
+        )
     }
 
     /// Detection mode (Eq. 9) with a fixed scale of Table 5: q = 0 ↦ DN 0 and
@@ -230,6 +267,20 @@ fn full_scale(bits: u8) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixed_gain_is_the_affine_map_of_radiance_scaled_by_bit_depth() {
+        let m = DnMapping::radiometry_fixed_gain(12.0, 1024.0, 14).unwrap();
+        // F = π·L: L = 10 W m⁻² sr⁻¹ gives 120 DN above the pedestal.
+        let f = core::f64::consts::PI * 10.0;
+        assert!((m.dn(f) - 1144.0).abs() < 1e-9);
+        assert!((m.dn(0.0) - 1024.0).abs() < 1e-12);
+        let m12 = DnMapping::radiometry_fixed_gain(12.0, 1024.0, 12).unwrap();
+        assert!((m12.dn(f) - 1144.0 / 4.0).abs() < 1e-9);
+        assert!(DnMapping::radiometry_fixed_gain(0.0, 0.0, 14).is_err());
+        assert!(DnMapping::radiometry_fixed_gain(1.0, f64::NAN, 14).is_err());
+        assert!(DnMapping::radiometry_fixed_gain(1.0, 0.0, 17).is_err());
+    }
 
     #[test]
     fn quantise_saturates_and_never_wraps() {

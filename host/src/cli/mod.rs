@@ -9,6 +9,7 @@
 //! | `fixtures` | [`fixtures`] |
 //! | `demo` | [`demo`] |
 //! | `sensor` | [`sensor`] |
+//! | `sensor-fit` | [`sensor_fit`] |
 //! | `eval` | [`eval`] |
 //! | `paper` (the default) | [`paper`] |
 //! | `render` | [`render`] |
@@ -30,6 +31,7 @@ pub mod methods;
 pub mod paper;
 pub mod render;
 pub mod sensor;
+pub mod sensor_fit;
 pub mod tune;
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
@@ -92,6 +94,9 @@ pub enum Command {
     ///                     "sigma_t4_over_pi_w_m2_sr","dn","saturated","t_rad_k"}]}
     #[command(verbatim_doc_comment)]
     Sensor(sensor::SensorArgs),
+    /// Fit the camera's own signature (shading, column/row pattern, hot and dead pixels,
+    /// per-pixel residual, gain) on a real FITS frame and write the calibration TOML.
+    SensorFit(sensor_fit::SensorFitArgs),
     /// Score detectors on a directory of 16-bit PNG frames with a truth.csv: mean and
     /// median IoU, hit rate (IoU >= 0.5) and core time per method and per group
     /// (mode, scale, target, material, illumination, range band). Markdown on stdout;
@@ -127,6 +132,7 @@ pub fn main() -> ExitCode {
         Command::Demo { repeat, figures } => demo::run(repeat as usize, figures.as_deref()),
         Command::Fixtures { out } => exit_code(fixtures::run(&out)),
         Command::Sensor(args) => sensor::run(&args),
+        Command::SensorFit(args) => exit_code(sensor_fit::run(&args)),
         Command::Eval(args) => exit_code(eval::run(&args)),
         Command::Paper(args) => exit_code(paper::run(&args)),
         Command::Tune(args) => exit_code(tune::run(&args)),

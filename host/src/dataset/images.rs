@@ -14,7 +14,7 @@ use crate::imaging::image_io::{self, FrameBuf};
 use crate::imaging::overlay;
 use crate::imaging::render::{self, Rendered};
 use crate::world::geom::Vec3;
-use crate::world::scene::{SceneFile, TargetModel};
+use crate::world::scene::{RadiometryReadout, SceneFile, TargetModel};
 
 /// The `target` label of a frame rendered without the target.
 pub const NO_TARGET: &str = "none";
@@ -85,6 +85,9 @@ pub struct ImageRecord {
     /// saturation is at 2^bits − 1.
     #[serde(default = "default_bits")]
     pub bits: u8,
+    /// Radiometry DN map: `auto` (Eq. 17) or `fixed-gain`; `table-5` in detection mode.
+    #[serde(default)]
+    pub readout: String,
     /// Factor on the mode's DN gain (scene `gain`).
     #[serde(default = "unit")]
     pub gain_factor: f64,
@@ -202,6 +205,11 @@ fn record(
         signal_to_clutter: frame.clutter.map(|c| c.signal_to_clutter),
         noise_seed: plan.noise_seed,
         bits: frame.mapping.bits(),
+        readout: match (plan.scale, plan.readout) {
+            (Some(_), _) => "table-5".into(),
+            (None, RadiometryReadout::Auto) => "auto".into(),
+            (None, RadiometryReadout::FixedGain) => "fixed-gain".into(),
+        },
         gain_factor: plan.gain_factor,
         netd_k: file.camera.netd_k * plan.netd_factor,
         moon_in_view: plan.moon.is_some(),

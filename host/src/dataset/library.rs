@@ -10,14 +10,18 @@ use tirroi_core::sensor::{BandLut, BandRadiance, DetectionScale};
 
 use super::DatasetError;
 use super::plan::{ImagePlan, ThermalKey, thermal_orbit};
+use crate::imaging::psf::OpticsPsf;
 use crate::imaging::render::{
-    self, EarthView, MoonView, Readout, RenderInput, Rendered, TargetView,
+    self, EarthView, FixedGain, MoonView, Readout, RenderInput, Rendered, SensorEffects, TargetView,
 };
+use crate::imaging::signature::{Calibration, SensorSignature};
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::earth::{EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
-use crate::world::scene::{Camera, EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::scene::{
+    Camera, EarthSource, Illumination, RadiometryReadout, SceneFile, SignatureKind, TargetModel,
+};
 use crate::world::spacecraft::thermal::{TRANSIENT_STEP_S, facet_heat_capacities_j_k};
 use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, ThermalNetwork, cube_cylinder, solve_steady_state,
@@ -48,6 +52,61 @@ pub struct Library {
     pub(super) earth: HashMap<(Illumination, usize), Arc<EarthMap>>,
     /// Seconds spent building the library: meshes, thermal solutions, Earth maps.
     pub build_s: [f64; 3],
+    /// The optics PSF when `[camera] optics_psf` is on.
+    pub psf: Option<OpticsPsf>,
+    /// A pool of [`SIGNATURE_POOL`] signature realisations when `[camera] signature`
+    /// is not "none"; each image takes one by a hash of the dataset seed and its index.
+    pub signature: Vec<SensorSignature>,
+    /// The fixed-gain radiometry readout when a scene kind (or `[camera] readout`)
+    /// reads out with it; each radiometry frame planned with
+    /// [`RadiometryReadout::FixedGain`] uses it at its own bit depth.
+    pub fixed_gain: Option<FixedGain>,
+}
+
+/// Salt of the per-image signature seed (so it is independent of the noise seed).
+const SIGNATURE_SEED_SALT: u64 = 0x5167_0000_0000_0015;
+
+/// Signature realisations made per dataset: one costs about 7 ms (328 × 248, release),
+/// too slow per image at 150 frames/s, so images draw from a pool (64 realisations,
+/// 21 MB at 328 × 248) made once in parallel.
+pub const SIGNATURE_POOL: usize = 64;
+
+/// The sensor-effect pieces of a camera: PSF, signature calibration, fixed-gain map.
+type SensorPieces = (Option<OpticsPsf>, Vec<SensorSignature>, Option<FixedGain>);
+
+fn sensor_pieces(file: &SceneFile) -> Result<SensorPieces, DatasetError> {
+    let cam = &file.camera;
+    let err = |e: String| DatasetError(format!("camera: {e}"));
+    let psf = if cam.optics_psf {
+        Some(OpticsPsf::hayabusa2_tir(cam.pixel_pitch_um).map_err(err)?)
+    } else {
+        None
+    };
+    let fixed_readout = file
+        .scenes
+        .iter()
+        .any(|s| s.readouts(cam).contains(&RadiometryReadout::FixedGain));
+    let needs_cal = cam.signature != SignatureKind::None || fixed_readout;
+    let cal = if needs_cal {
+        Some(Calibration::hayabusa2_tir().map_err(err)?)
+    } else {
+        None
+    };
+    let fixed = cal
+        .as_ref()
+        .filter(|_| fixed_readout)
+        .map(Calibration::fixed_gain);
+    let signature = match (&cal, cam.signature) {
+        (Some(c), SignatureKind::Hayabusa2Dark) => (0..SIGNATURE_POOL as u64)
+            .into_par_iter()
+            .map(|k| {
+                let seed = splitmix64(file.dataset.seed ^ SIGNATURE_SEED_SALT ^ k);
+                c.realise(cam.width, cam.height, seed)
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
+    Ok((psf, signature, fixed))
 }
 
 fn olr_grid(file: &SceneFile, day: usize) -> Result<OlrGrid, DatasetError> {
@@ -268,9 +327,13 @@ impl Library {
             .collect::<Result<_, DatasetError>>()?;
         thermal.extend(transient.into_iter().flatten());
         let t3 = Instant::now();
+        let (psf, signature, fixed_gain) = sensor_pieces(file)?;
         Ok(Library {
             band,
             lut,
+            psf,
+            signature,
+            fixed_gain,
             meshes,
             thermal,
             earth,
@@ -316,6 +379,10 @@ impl Library {
             netd_k: file.camera.netd_k * plan.netd_factor,
             ..file.camera
         };
+        let realisation = (!self.signature.is_empty()).then(|| {
+            let k = splitmix64(file.dataset.seed ^ SIGNATURE_SEED_SALT ^ plan.index as u64);
+            &self.signature[(k % self.signature.len() as u64) as usize]
+        });
         let input = RenderInput {
             camera: &camera,
             readout: match plan.scale {
@@ -340,6 +407,13 @@ impl Library {
                 dir_camera: m.dir_camera,
                 sun_dir_camera: m.sun_dir_camera,
             }),
+            sensor: SensorEffects {
+                psf: self.psf.as_ref(),
+                signature: realisation,
+                fixed_gain: self
+                    .fixed_gain
+                    .filter(|_| plan.readout == RadiometryReadout::FixedGain),
+            },
         };
         let err = |e: render::RenderError| DatasetError(format!("image {}: {e}", plan.index));
         let mut frame = render::render(&input).map_err(err)?;

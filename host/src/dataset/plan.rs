@@ -7,7 +7,9 @@ use rand_pcg::Pcg64;
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
 use crate::world::geom::{Rotation, Vec3, normalize, scale};
-use crate::world::scene::{Illumination, Mode, SceneFile, TargetModel, ThermalModel};
+use crate::world::scene::{
+    Illumination, Mode, RadiometryReadout, SceneFile, TargetModel, ThermalModel,
+};
 use crate::world::spacecraft::MaterialCase;
 use crate::world::spacecraft::thermal::Orbit;
 
@@ -52,6 +54,9 @@ pub struct ImagePlan {
     pub netd_factor: f64,
     /// Bit depth of the DN map (scene `bits`, else the camera's).
     pub bits: u8,
+    /// Radiometry DN map of this pose (scene `readout`, else the camera's; cycled by
+    /// pose); unused in detection mode.
+    pub readout: RadiometryReadout,
     /// The Moon, when it is in the field of view.
     pub moon: Option<MoonPlan>,
     /// Whether the target is rendered (false: a no-target frame,
@@ -332,6 +337,10 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 let b = b.values();
                 b[pose % b.len()]
             });
+            let readout = {
+                let r = spec.readouts(&file.camera);
+                r[pose % r.len()]
+            };
             let moon = spec.moon.and_then(|m| {
                 let u: f64 = rng.r#gen();
                 let x = rng.gen_range(0.0..file.camera.width as f64);
@@ -381,6 +390,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     gain_factor,
                     netd_factor,
                     bits,
+                    readout,
                     moon,
                     has_target: !empty,
                 });

@@ -33,6 +33,12 @@
 //! frame's minimum F (kept at DN 0), so a factor above 1 clips the brightest pixels.
 //! The core's [`expose_frame`] then adds the noise (Eq. 18,
 //! scaled to the NETD) and quantises.
+//!
+//! **Sensor effects** (opt-in, [`SensorEffects`]; none by default, leaving the frames
+//! bit-identical): the optics' PSF blurs the signal ([`OpticsPsf`]), then the camera's
+//! own signature multiplies it by the per-pixel gain and adds its radiance offset map
+//! in the readout's signal unit ([`SensorSignature`]); a fixed-gain radiometry map
+//! ([`DnMapping::radiometry_fixed_gain`]) may replace the auto range.
 
 use std::time::Instant;
 
@@ -44,6 +50,8 @@ use tirroi_core::sensor::{
     SensorError, expose_frame,
 };
 
+use crate::imaging::psf::OpticsPsf;
+use crate::imaging::signature::SensorSignature;
 use crate::world::earth::EarthMap;
 use crate::world::geom::{Rotation, Vec3, norm, scale};
 use crate::world::scene::Camera;
@@ -112,6 +120,37 @@ pub enum Readout {
     Detection(DetectionScale),
 }
 
+/// The camera's optional sensor effects (all off in [`SensorEffects::NONE`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SensorEffects<'a> {
+    /// The optics' PSF applied to the signal before the DN map.
+    pub psf: Option<&'a OpticsPsf>,
+    /// A realisation of the camera's signature (the frame's size).
+    pub signature: Option<&'a SensorSignature>,
+    /// Radiometry mode only: this fixed gain and pedestal instead of the auto range of
+    /// Eq. 17 (made into the frame's DN map at its bit depth).
+    pub fixed_gain: Option<FixedGain>,
+}
+
+/// A fixed-gain radiometry readout, DN = a·F + b at the reference 14 bits
+/// ([`DnMapping::radiometry_fixed_gain`] scales both by 2^(bits − 14)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixedGain {
+    /// Camera gain, DN per W m⁻² sr⁻¹ of scene radiance (> 0).
+    pub dn_per_w_m2_sr: f64,
+    /// Pedestal, DN: what deep space reads.
+    pub pedestal_dn: f64,
+}
+
+impl SensorEffects<'_> {
+    /// No sensor effects: the paper's renderer.
+    pub const NONE: SensorEffects<'static> = SensorEffects {
+        psf: None,
+        signature: None,
+        fixed_gain: None,
+    };
+}
+
 /// Everything one frame needs.
 #[derive(Debug, Clone, Copy)]
 pub struct RenderInput<'a> {
@@ -136,6 +175,8 @@ pub struct RenderInput<'a> {
     pub gain_factor: f64,
     /// The Moon, if in the field of view.
     pub moon: Option<MoonView>,
+    /// PSF, signature and fixed-gain readout ([`SensorEffects::NONE`] for none).
+    pub sensor: SensorEffects<'a>,
 }
 
 /// Time spent and work done per stage of one frame.
@@ -149,6 +190,8 @@ pub struct RenderStats {
     pub expose_ns: u64,
     /// The signal-to-clutter twin ([`signal_to_clutter`]; 0 when not computed), ns.
     pub clutter_ns: u64,
+    /// Optics PSF and sensor signature, ns (0 without them).
+    pub sensor_ns: u64,
     /// Pixels inside the target's projected bounds.
     pub target_region_px: usize,
     /// Pixels supersampled at the target's edges.
@@ -166,7 +209,8 @@ pub struct Rendered {
     pub height: usize,
     /// DN, row-major.
     pub dn: Vec<u16>,
-    /// Signal before the DN map: F (W m⁻², radiometry) or q_fc (W m⁻², detection).
+    /// Signal before the DN map: F (W m⁻², radiometry) or q_fc (W m⁻², detection),
+    /// after the optics PSF and the sensor signature when they are on.
     pub signal: Vec<f32>,
     /// Target coverage per pixel, 0..=1.
     pub coverage: Vec<f32>,
@@ -319,11 +363,43 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     }
     stats.earth_ns = t1.elapsed().as_nanos() as u64;
 
+    // Radiance → this readout's signal unit: F = π·L, q_fc = L·ΔA_c/r² (face-on).
+    let signal_per_radiance_sr = match input.readout {
+        Readout::Radiometry => std::f64::consts::PI,
+        Readout::Detection(_) => SENSOR_AREA_M2 / input.earth_distance_m / input.earth_distance_m,
+    };
+    let ts = Instant::now();
+    if let Some(psf) = input.sensor.psf {
+        let mut blurred = vec![0f32; n];
+        psf.apply(&signal, cam.w, &mut blurred)
+            .map_err(RenderError::Input)?;
+        signal = blurred;
+    }
+    if let Some(sig) = input.sensor.signature {
+        if sig.width != cam.w || sig.height != cam.h {
+            return Err(RenderError::Input(format!(
+                "sensor signature of {} × {} px for a {} × {} camera: expected the camera's size",
+                sig.width, sig.height, cam.w, cam.h
+            )));
+        }
+        sig.apply(&mut signal, signal_per_radiance_sr)
+            .map_err(RenderError::Input)?;
+    }
+    if input.sensor.psf.is_some() || input.sensor.signature.is_some() {
+        stats.sensor_ns = ts.elapsed().as_nanos() as u64;
+    }
+
     let t2 = Instant::now();
     let bits = input.camera.bits;
-    let mapping = match input.readout {
-        Readout::Detection(scale) => DnMapping::detection(scale, bits)?,
-        Readout::Radiometry => {
+    let mapping = match (input.readout, input.sensor.fixed_gain) {
+        (Readout::Detection(scale), _) => DnMapping::detection(scale, bits)?,
+        // The frame's gain factor multiplies the camera gain; the pedestal stays.
+        (Readout::Radiometry, Some(fixed)) => DnMapping::radiometry_fixed_gain(
+            fixed.dn_per_w_m2_sr * input.gain_factor,
+            fixed.pedestal_dn,
+            bits,
+        )?,
+        (Readout::Radiometry, None) => {
             // Eq. 17 over the pure pixels, with the span kept at least
             // MIN_RANGE_NETD NETDs wide (in F at the reference temperature), so a
             // near-uniform scene is not stretched until its noise fills the frame.
@@ -349,7 +425,11 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
             "gain factor {g}: expected a finite number > 0"
         )));
     }
-    let mapping = if g == 1.0 {
+    let fixed = matches!(
+        (input.readout, input.sensor.fixed_gain),
+        (Readout::Radiometry, Some(_))
+    );
+    let mapping = if g == 1.0 || fixed {
         mapping
     } else {
         // About the signal that maps to DN 0 (radiometry: the frame's minimum F).
@@ -361,12 +441,6 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     let mut field = match input.noise_seed {
         None => None,
         Some(seed) => {
-            let signal_per_radiance_sr = match input.readout {
-                Readout::Radiometry => std::f64::consts::PI,
-                Readout::Detection(_) => {
-                    SENSOR_AREA_M2 / input.earth_distance_m / input.earth_distance_m
-                }
-            };
             let dn_per_k = mapping.dn_per_kelvin(
                 input.band,
                 input.camera.netd_reference_k,

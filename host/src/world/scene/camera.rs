@@ -66,6 +66,57 @@ pub struct Camera {
     /// Spectral response: "hayabusa2" (the measured curve, default), "tir" (the
     /// analytic bell) or "flat".
     pub response: ResponseName,
+    /// The camera's own signature added to every frame (`"none"`, the default, or
+    /// `"hayabusa2-dark"`: shading, column/row pattern, hot and dead pixels and gain
+    /// residual fitted on a real TIR deep-space frame, a new realisation per image).
+    #[serde(skip_serializing_if = "SignatureKind::is_none")]
+    pub signature: SignatureKind,
+    /// Blur the signal with the optics' PSF (Airy at F/1.4 over the pixel footprint)
+    /// before the DN map (default false).
+    #[serde(skip_serializing_if = "is_false")]
+    pub optics_psf: bool,
+    /// Radiometry-mode DN map: `"auto"` (the default, the paper's Eq. 17 per frame) or
+    /// `"fixed-gain"` (the real camera's gain and a pedestal, DN = a·F + b).
+    #[serde(skip_serializing_if = "RadiometryReadout::is_auto")]
+    pub readout: RadiometryReadout,
+}
+
+/// Which sensor signature a camera adds (`[camera] signature`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SignatureKind {
+    /// No signature: today's frames.
+    #[default]
+    None,
+    /// The Hayabusa2 TIR's, fitted on `dark_20180629_083003.fit`.
+    Hayabusa2Dark,
+}
+
+impl SignatureKind {
+    fn is_none(&self) -> bool {
+        *self == SignatureKind::None
+    }
+}
+
+/// The radiometry-mode DN map (`[camera] readout`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RadiometryReadout {
+    /// Auto-ranged per frame over the scene (Eq. 17).
+    #[default]
+    Auto,
+    /// A fixed gain (the real camera's, at 14 bits) and a pedestal.
+    FixedGain,
+}
+
+impl RadiometryReadout {
+    fn is_auto(&self) -> bool {
+        *self == RadiometryReadout::Auto
+    }
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 impl Default for Camera {
@@ -80,6 +131,9 @@ impl Default for Camera {
             netd_reference_k: 300.0,
             flicker_correlation_px: DEFAULT_FLICKER_CORRELATION_PX,
             response: ResponseName::Hayabusa2,
+            signature: SignatureKind::None,
+            optics_psf: false,
+            readout: RadiometryReadout::Auto,
         }
     }
 }

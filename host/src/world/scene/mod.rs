@@ -29,6 +29,15 @@
 //! max_offset_fraction = 1.3         # > 1: targets cut by the frame edge
 //! moon = { probability = 0.1 }
 //! ```
+//!
+//! Opt-in camera realism (all off by default, which keeps today's frames):
+//!
+//! ```toml
+//! [camera]
+//! signature = "hayabusa2-dark"  # the real TIR's shading, column/row pattern, hot pixels
+//! optics_psf = true             # Airy (F/1.4) over the pixel footprint, before the DN map
+//! readout = "fixed-gain"        # radiometry: DN = a·F + b (real gain, 1024 DN pedestal)
+//! ```
 
 use std::fmt;
 use std::path::Path;
@@ -41,7 +50,7 @@ mod spec;
 #[cfg(test)]
 mod tests;
 
-pub use camera::{Camera, ResponseName};
+pub use camera::{Camera, RadiometryReadout, ResponseName, SignatureKind};
 pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
 pub use spec::{
     DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION,

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::DetectionScale;
 
+use super::camera::{Camera, RadiometryReadout};
 use super::kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
@@ -227,6 +228,11 @@ pub struct SceneSpec {
     /// The Moon in the field of view with some probability (omitted: never).
     #[serde(default)]
     pub moon: Option<MoonSpec>,
+    /// Radiometry DN map per pose: `"auto"` (Eq. 17), `"fixed-gain"`, or a list the
+    /// poses cycle through (e.g. both, so the kind is read out both ways); omitted:
+    /// `[camera] readout`. Recorded per frame as `readout` in `metadata.jsonl`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub readout: Option<OneOrMany<RadiometryReadout>>,
     /// Share of this kind's poses rendered without the target (0..=1, default 0): the
     /// same camera, Earth and noise, nothing to detect (`target = "none"` in the labels,
     /// empty truth box). ⌈share × poses⌉ poses, picked by a permutation seeded from the
@@ -285,6 +291,14 @@ fn full_circle() -> Param {
 }
 
 impl SceneSpec {
+    /// The radiometry readouts the poses of this kind cycle through: the scene's
+    /// `readout`, else the camera's.
+    pub fn readouts(&self, camera: &Camera) -> Vec<RadiometryReadout> {
+        self.readout
+            .as_ref()
+            .map_or_else(|| vec![camera.readout], OneOrMany::values)
+    }
+
     /// The detection scales of this kind (one entry, unused, for radiometry).
     pub fn scales(&self) -> Vec<DetectionScale> {
         match self.mode {
@@ -406,6 +420,11 @@ impl SceneSpec {
                     "{at}.bits = {b:?}: expected a bit depth 1..=16 (e.g. 12, 14, 16) or a non-empty list of them"
                 ));
             }
+        }
+        if self.readout.as_ref().is_some_and(|r| r.values().is_empty()) {
+            return Err(format!(
+                "{at}.readout = []: expected \"auto\", \"fixed-gain\" or a non-empty list of them"
+            ));
         }
         if let Some(m) = self.moon {
             if !(0.0..=1.0).contains(&m.probability) {

@@ -111,3 +111,20 @@ fn no_target_share_and_truth_coverage_are_checked() {
         assert!(!text.contains("no_target_fraction") && !text.contains("truth_coverage"));
     }
 }
+
+#[test]
+fn camera_sensor_keys_are_opt_in_and_checked() {
+    use super::{RadiometryReadout, SignatureKind};
+    let c: super::Camera = toml::from_str(
+        "signature = \"hayabusa2-dark\"\noptics_psf = true\nreadout = \"fixed-gain\"\n",
+    )
+    .unwrap();
+    assert_eq!(c.signature, SignatureKind::Hayabusa2Dark);
+    assert!(c.optics_psf);
+    assert_eq!(c.readout, RadiometryReadout::FixedGain);
+    // The defaults are not written, so printed presets are unchanged.
+    let d = toml::to_string(&super::Camera::default()).unwrap();
+    assert!(!d.contains("signature") && !d.contains("optics_psf") && !d.contains("readout"));
+    let e = toml::from_str::<super::Camera>("signature = \"real\"\n").unwrap_err();
+    assert!(e.to_string().contains("hayabusa2-dark"), "{e}");
+}
