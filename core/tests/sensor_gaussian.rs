@@ -4,8 +4,8 @@
 //! 4 σ tails, serial correlation).
 
 use tirroi_core::sensor::gaussian::{
-    LAYER_DENSITY, LAYER_UNIFORM_BOUND, LAYER_WIDTH_PER_UNIT, LAYERS, TAIL_START_F64,
-    standard_normal,
+    LAYER_DENSITY, LAYER_UNIFORM_BOUND, LAYER_WIDTH_PER_UNIT, LAYERS, SIGNED_WIDTH_PER_UNIT,
+    TAIL_START_F64, standard_normal,
 };
 use tirroi_core::sensor::rng::Xoshiro128pp;
 
@@ -82,6 +82,11 @@ fn tables_satisfy_the_ziggurat_equations() {
                 "strip {i}: {last}"
             );
         }
+    }
+    // The signed table the fast path reads: +width, then −width.
+    for i in 0..LAYERS {
+        assert_eq!(SIGNED_WIDTH_PER_UNIT[i], LAYER_WIDTH_PER_UNIT[i]);
+        assert_eq!(SIGNED_WIDTH_PER_UNIT[LAYERS + i], -LAYER_WIDTH_PER_UNIT[i]);
     }
     // The fast path's share: the mean of the bounds, 97.2 % for 128 strips.
     let fast: f64 = LAYER_UNIFORM_BOUND
