@@ -27,6 +27,7 @@ pub mod band_lut;
 pub mod dn;
 pub mod expose;
 pub mod flux;
+pub mod gaussian;
 pub mod noise;
 pub mod planck;
 pub mod response;

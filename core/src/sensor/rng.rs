@@ -1,8 +1,11 @@
 //! The noise generator: xoshiro128++ (D. Blackman and S. Vigna, "Scrambled linear
 //! pseudorandom number generators", ACM TOMS 47(4), 2021; reference code at
-//! prng.di.unimi.it), seeded by SplitMix64 as its authors recommend, and Gaussian pairs
-//! by the Box–Muller transform. 16 bytes of state, 32-bit operations only (native on a
-//! Cortex-M), the same stream on every target for a seed.
+//! prng.di.unimi.it), seeded by SplitMix64 as its authors recommend. 16 bytes of state,
+//! 32-bit operations only (native on a Cortex-M), the same stream on every target for a
+//! seed. The noise field draws its Gaussians from it with the table-driven ziggurat of
+//! [`super::gaussian`] (one 32-bit draw and no libm for 97 % of deviates);
+//! [`Xoshiro128pp::gaussian_pair`] (Box–Muller, two libm calls per pair) is kept as a
+//! simple reference generator.
 //!
 //! It is also the one generator of the core's tests: `core/tests/common` draws its
 //! random test frames and masks from [`Xoshiro128pp::seed_from_u64`] and

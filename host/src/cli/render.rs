@@ -85,7 +85,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     };
     let s = dataset::write_dataset(&file, &args.out, &options).map_err(|e| e.to_string())?;
     let render_s = s.wall_s[1].max(1e-9);
-    let cpu: f64 = s.stage_cpu_s.iter().sum();
+    let cpu: f64 = s.stage_cpu_s.iter().sum::<f64>() + s.other_cpu_s;
     let pct = |v: f64| if cpu > 0.0 { 100.0 * v / cpu } else { 0.0 };
     println!(
         "{} images rendered ({} resumed) in {:.2} s: {:.1} images/s; library {:.2} s ({} meshes {:.2} s, {} thermal solutions {:.2} s, {} Earth maps {:.2} s); labels {:.2} s",
@@ -103,17 +103,27 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         s.wall_s[2],
     );
     println!(
-        "per-image CPU time by stage: target {:.1} % | Earth {:.1} % | DN + noise {:.1} % | PNG encode + write {:.1} % | signal-to-clutter twin {:.1} % ({:.2} ms per image)",
+        "per-image CPU time by stage: target {:.1} % | Earth {:.1} % | PSF + signature {:.1} % | DN + noise {:.1} % | PNG encode + write {:.1} % | signal-to-clutter twin {:.1} % | other {:.1} % ({:.2} ms per image)",
         pct(s.stage_cpu_s[0]),
         pct(s.stage_cpu_s[1]),
         pct(s.stage_cpu_s[2]),
         pct(s.stage_cpu_s[3]),
         pct(s.stage_cpu_s[4]),
+        pct(s.stage_cpu_s[5]),
+        pct(s.other_cpu_s),
         if s.rendered > 0 {
             cpu * 1e3 / s.rendered as f64
         } else {
             0.0
         },
+    );
+    // Steady state: the render phase alone (library set-up and labels excluded), and
+    // how busy the workers were (per-image time over the phase's thread-seconds).
+    println!(
+        "steady state: {:.1} frames/s on {} threads, workers {:.0} % busy in images",
+        s.rendered as f64 / render_s,
+        s.threads,
+        100.0 * cpu / (render_s * s.threads.max(1) as f64),
     );
     println!("labels: {}", dataset::truth_path(&args.out).display());
     Ok(())

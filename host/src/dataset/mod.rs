@@ -86,9 +86,14 @@ pub struct RunSummary {
     pub library_s: [f64; 3],
     /// Distinct meshes, thermal solutions and Earth maps.
     pub library_counts: (usize, usize, usize),
-    /// Summed per-image CPU time per stage, s: target, Earth, expose, PNG encode + write,
-    /// signal-to-clutter twin.
-    pub stage_cpu_s: [f64; 5],
+    /// Summed per-image CPU time per stage, s: target, Earth, optics PSF + sensor
+    /// signature, expose (DN + noise), PNG encode + write, signal-to-clutter twin.
+    pub stage_cpu_s: [f64; 6],
+    /// Summed per-image time outside those stages, s: the frame's set-up (buffers, DN
+    /// map, noise scale), its record and mask count, the journal line.
+    pub other_cpu_s: f64,
+    /// Worker threads the images were rendered on (rayon's pool size).
+    pub threads: usize,
 }
 
 /// Renders every image of `file` into `dir` with labels (module docs).
@@ -141,9 +146,10 @@ pub fn write_dataset(
     } else {
         ProgressBar::hidden()
     };
-    let results: Vec<Result<(ImageRecord, RenderStats, f64), DatasetError>> = todo
+    let results: Vec<Result<(ImageRecord, RenderStats, f64, f64), DatasetError>> = todo
         .par_iter()
         .map(|plan| {
+            let start = Instant::now();
             let (frame, thermal) = library.render(file, plan)?;
             let (rec, write_s) = write_image(dir, file, plan, &frame, &thermal, options)?;
             let line = serde_json::to_string(&rec).map_err(|e| DatasetError(e.to_string()))?;
@@ -154,7 +160,7 @@ pub fn write_dataset(
                 writeln!(j, "{line}").map_err(|e| io(&journal_path, e))?;
             }
             bar.inc(1);
-            Ok((rec, frame.stats, write_s))
+            Ok((rec, frame.stats, write_s, start.elapsed().as_secs_f64()))
         })
         .collect();
     bar.finish_and_clear();
@@ -162,16 +168,24 @@ pub fn write_dataset(
         skipped: done.len(),
         library_s: library.build_s,
         library_counts: library.counts(),
+        threads: rayon::current_num_threads(),
         ..RunSummary::default()
     };
     for r in results {
-        let (rec, stats, write_s) = r?;
+        let (rec, stats, write_s, image_s) = r?;
         summary.rendered += 1;
-        summary.stage_cpu_s[0] += stats.target_ns as f64 * 1e-9;
-        summary.stage_cpu_s[1] += stats.earth_ns as f64 * 1e-9;
-        summary.stage_cpu_s[2] += stats.expose_ns as f64 * 1e-9;
-        summary.stage_cpu_s[3] += write_s;
-        summary.stage_cpu_s[4] += stats.clutter_ns as f64 * 1e-9;
+        let stages = [
+            stats.target_ns as f64 * 1e-9,
+            stats.earth_ns as f64 * 1e-9,
+            stats.sensor_ns as f64 * 1e-9,
+            stats.expose_ns as f64 * 1e-9,
+            write_s,
+            stats.clutter_ns as f64 * 1e-9,
+        ];
+        for (sum, v) in summary.stage_cpu_s.iter_mut().zip(stages) {
+            *sum += v;
+        }
+        summary.other_cpu_s += (image_s - stages.iter().sum::<f64>()).max(0.0);
         done.insert(rec.index, rec);
     }
     let t2 = Instant::now();

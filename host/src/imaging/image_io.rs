@@ -114,8 +114,17 @@ pub fn read_frame(path: &Path, bits: Option<u8>) -> Result<FrameBuf, FrameFileEr
 
 /// 16-bit samples in native byte order, the layout the `image` encoders take.
 pub fn native_bytes(samples: &[u16]) -> Vec<u8> {
-    samples.iter().flat_map(|v| v.to_ne_bytes()).collect()
+    let mut out = Vec::with_capacity(2 * samples.len());
+    for v in samples {
+        out.extend_from_slice(&v.to_ne_bytes());
+    }
+    out
 }
+
+/// Room reserved for a PNG's bytes beyond its raw samples: signature, IHDR, IEND, the
+/// per-row filter bytes and zlib/deflate block overhead (stored blocks add 5 bytes per
+/// 64 KiB), so that the output buffer is allocated once, not grown by doubling.
+const PNG_OVERHEAD_BYTES: usize = 4096;
 
 /// PNG bytes of `width` × `height` pixels of `colour` (16-bit samples in native byte
 /// order, [`native_bytes`]), with fast deflate and the Sub filter: on 200 rendered
@@ -132,7 +141,7 @@ pub fn encode_png(
 ) -> Result<Vec<u8>, image::ImageError> {
     use image::ImageEncoder;
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    let mut out = Vec::new();
+    let mut out = Vec::with_capacity(bytes.len() + height as usize + PNG_OVERHEAD_BYTES);
     PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub)
         .write_image(bytes, width, height, colour)?;
     Ok(out)

@@ -81,9 +81,15 @@ struct ScreenTriangle {
 impl ScreenTriangle {
     /// Barycentric-interpolated 1/z at (u, v) when the point is inside.
     pub(super) fn inside(&self, u: f64, v: f64) -> Option<f32> {
-        let e0 = self.edges[0].at(u, v);
-        let e1 = self.edges[1].at(u, v);
-        let e2 = self.edges[2].at(u, v);
+        self.inside_from([
+            self.edges[0].at(u, v),
+            self.edges[1].at(u, v),
+            self.edges[2].at(u, v),
+        ])
+    }
+
+    /// As [`ScreenTriangle::inside`], from the three edge values already evaluated.
+    pub(super) fn inside_from(&self, [e0, e1, e2]: [f64; 3]) -> Option<f32> {
         if e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0 {
             // e0 is opposite vertex 2 (edge 0→1), e1 opposite 0, e2 opposite 1.
             let iz =
@@ -222,7 +228,7 @@ pub(super) fn render_target(
                 if (0..3).all(|k| tri.edges[k].conservative(e[k]) >= 0.0) {
                     touched[i] = true;
                 }
-                if let Some(iz) = tri.inside(u, v) {
+                if let Some(iz) = tri.inside_from(e) {
                     if iz > centre_inv_z[i] {
                         centre_inv_z[i] = iz;
                         centre_facet[i] = tri.facet;
