@@ -41,7 +41,7 @@ fn main() -> Result<(), String> {
     let lut = BandLut::new(&band);
     let cal = Calibration::hayabusa2_tir()?;
     let psf = OpticsPsf::hayabusa2_tir(camera.pixel_pitch_um)?;
-    let fixed = cal.fixed_gain_mapping(camera.bits)?;
+    let fixed = cal.fixed_gain();
     let sig = cal.realise(w, h, 2026);
     let input = RenderInput {
         camera: &camera,
@@ -52,6 +52,8 @@ fn main() -> Result<(), String> {
         noise_seed: Some(7),
         band: &band,
         lut: &lut,
+        gain_factor: 1.0,
+        moon: None,
         sensor: SensorEffects {
             psf: Some(&psf),
             signature: Some(&sig),
