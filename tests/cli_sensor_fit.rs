@@ -45,7 +45,7 @@ fn sensor_fit_writes_the_committed_calibration() {
     );
     // The summary line carries the headline numbers.
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("hot 34") && err.contains("gain 12.6"), "{err}");
+    assert!(err.contains("hot 34") && err.contains("gain 14.2"), "{err}");
 }
 
 #[test]
