@@ -13,9 +13,9 @@ use super::plan::{ImagePlan, ThermalKey};
 use crate::imaging::render::{self, EarthView, Readout, RenderInput, Rendered, TargetView};
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
-use crate::world::earth::{EarthMap, OlrGrid};
+use crate::world::earth::{CloudField, EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
-use crate::world::scene::{EarthSource, Illumination, SceneFile, TargetModel};
+use crate::world::scene::{EarthSource, EarthTexture, Illumination, SceneFile, TargetModel};
 use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, cube_cylinder, solve_steady_state, tango,
 };
@@ -112,12 +112,23 @@ impl Library {
             .par_iter()
             .map(|&(ill, day)| {
                 let grid = &grids[&day];
-                let map = match ill {
-                    Illumination::Sunlit => EarthMap::refine(grid, file.earth_model.mesh_deg, &lut),
+                let scaled;
+                let grid = match ill {
+                    Illumination::Sunlit => grid,
                     Illumination::Eclipse => {
-                        EarthMap::refine(&grid.scaled(factor), file.earth_model.mesh_deg, &lut)
+                        scaled = grid.scaled(factor);
+                        &scaled
                     }
                 };
+                let map = EarthMap::refine(grid, file.earth_model.mesh_deg, &lut).map(|m| {
+                    match file.earth_model.texture {
+                        EarthTexture::Paper => m,
+                        // The same clouds by day and seed, whatever the illumination.
+                        EarthTexture::Clouds => {
+                            m.with_clouds(CloudField::new(grid, day as u64, file.dataset.seed))
+                        }
+                    }
+                });
                 map.map(|m| ((ill, day), Arc::new(m)))
                     .map_err(|e| DatasetError(format!("Earth map: {e}")))
             })

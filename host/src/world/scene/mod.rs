@@ -37,7 +37,7 @@ mod tests;
 
 pub use camera::Camera;
 pub use kinds::{Illumination, Mode, OneOrMany, Param, TargetModel};
-pub use spec::{DatasetSettings, EarthModel, EarthSource, SceneSpec};
+pub use spec::{DatasetSettings, EarthModel, EarthSource, EarthTexture, SceneSpec};
 
 /// A scene/dataset description: what a TOML file or a preset holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
