@@ -8,9 +8,7 @@ use image::{GrayImage, Luma};
 
 use crate::imaging::image_io::read_frame;
 use crate::seed::splitmix64;
-use crate::world::earth::texture_stats::{
-    PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, largest_valid_rectangle, sample_patch,
-};
+use crate::world::earth::texture_stats::{PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch};
 use crate::world::earth::{CloudField, OlrGrid};
 
 /// Arguments of `tirroi earth-texture`.
@@ -121,14 +119,8 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
             }
         }
         if let Some((w, h, t)) = &real {
-            let valid: Vec<bool> = t.iter().map(|v| v.is_finite()).collect();
-            let (x0, y0, rw, rh) = largest_valid_rectangle(&valid, *w, *h);
-            let sub: Vec<f64> = (y0..y0 + rh)
-                .flat_map(|y| (x0..x0 + rw).map(move |x| (x, y)))
-                .map(|(x, y)| t[y * w + x])
-                .collect();
-            if let Some(s) = TextureStats::of(&sub, rw, rh, PATCH_PX_KM) {
-                println!("{}", row(&format!("real ({rw}×{rh} px at {x0},{y0})"), &s));
+            if let Some(s) = TextureStats::of(t, *w, *h, PATCH_PX_KM) {
+                println!("{}", row("real (valid pixels)", &s));
             }
         }
     }

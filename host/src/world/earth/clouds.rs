@@ -20,7 +20,8 @@
 //!   ones stretched north–south so that bands run east–west) and θ its (1 − c)
 //!   quantile, so about a share c of the area is cloudy; the transition width
 //!   [`EDGE_WIDTH_SIGMA`] gives 1–3 px cloud edges at 4 km per pixel;
-//! - ΔT_local grows from 0.5 ΔT at a cloud's edge to 1.5 ΔT in its core;
+//! - ΔT_local grows from 0.5 ΔT at a cloud's edge to 1.5 ΔT in its core; the edge
+//!   width grows with ΔT (cold high-cloud fringes are softer than low-cloud edges);
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
 //!   (more or less cloud where the noise realisation has too little or too much); s
@@ -532,9 +533,12 @@ impl CloudField {
     #[inline]
     fn temperature(&self, p: &Point, shift: f64) -> f64 {
         let x = p.n - p.theta - shift;
-        let m = smoothstep(x / (EDGE_WIDTH_SIGMA * self.sigma) + 0.5);
+        // High (cold, deep) cloud edges are softer than low ones: the width grows with
+        // ΔT (thin cirrus fringes of anvils and fronts).
+        let width = EDGE_WIDTH_SIGMA * self.sigma * (p.dt / MIN_CLOUD_COLD_K).powf(1.25);
+        let m = smoothstep(x / width + 0.5);
         // Deeper (colder) towards a cloud's core: 0.5 ΔT at the edge, 1.5 ΔT well inside.
-        let core = smoothstep(x / (0.8 * self.sigma));
+        let core = smoothstep(x / (1.2 * self.sigma));
         p.t_clear - (m * p.dt * (0.5 + core)).min(MAX_CLOUD_COLD_K)
     }
 

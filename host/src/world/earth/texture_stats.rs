@@ -39,8 +39,10 @@ fn pct(v: &[f64], q: f64) -> f64 {
 }
 
 impl TextureStats {
-    /// Statistics of the row-major `w` × `h` image `t_k` (K) with pixels `px_km` apart.
-    /// All pixels must be valid; returns `None` for an image smaller than 16 × 16.
+    /// Statistics of the row-major `w` × `h` image `t_k` (K, NaN = no data) with
+    /// pixels `px_km` apart: steps between valid pixel pairs only, percentiles over the
+    /// valid pixels, the spectrum on the largest all-valid rectangle (as the README's
+    /// numbers were measured). `None` when that rectangle is smaller than 16 × 16.
     pub fn of(t_k: &[f64], w: usize, h: usize, px_km: f64) -> Option<TextureStats> {
         if w < 16 || h < 16 || t_k.len() != w * h {
             return None;
@@ -48,13 +50,24 @@ impl TextureStats {
         let mut steps: Vec<f64> = Vec::with_capacity((w - 2) * h);
         for row in t_k.chunks_exact(w) {
             for x in 0..w - 2 {
-                steps.push((row[x + 2] - row[x]).abs());
+                let d = (row[x + 2] - row[x]).abs();
+                if d.is_finite() {
+                    steps.push(d);
+                }
             }
         }
+        let valid: Vec<bool> = t_k.iter().map(|v| v.is_finite()).collect();
+        let (x0, y0, rw, rh) = largest_valid_rectangle(&valid, w, h);
+        if rw < 16 || rh < 16 || steps.is_empty() {
+            return None;
+        }
+        let rect: Vec<f64> = (y0..y0 + rh)
+            .flat_map(|y| t_k[y * w + x0..y * w + x0 + rw].iter().copied())
+            .collect();
         steps.sort_by(f64::total_cmp);
         let over =
             |lim: f64| steps.iter().filter(|&&s| s > lim).count() as f64 / steps.len() as f64;
-        let mut bt = t_k.to_vec();
+        let mut bt: Vec<f64> = t_k.iter().copied().filter(|v| v.is_finite()).collect();
         bt.sort_by(f64::total_cmp);
         Some(TextureStats {
             step2_k: [
@@ -64,7 +77,7 @@ impl TextureStats {
                 steps[steps.len() - 1],
             ],
             step2_share_over: [over(5.0), over(10.0), over(20.0)],
-            spectral_slope: spectral_slope(t_k, w, h, px_km),
+            spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
             steps: steps.len(),
         })
