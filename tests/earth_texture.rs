@@ -2,11 +2,11 @@
 //! per 1° cell, continuity across cell borders, determinism, the statistics tool
 //! against the real image's README numbers, and the acceptance ranges.
 
+use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 use tirroi_host::world::earth::texture_stats::{
     PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch,
 };
 use tirroi_host::world::earth::{CloudField, OlrGrid};
-use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 
 fn field(seed: u64, day: u64) -> CloudField {
     let grid = OlrGrid::builtin(tirroi_host::seed::splitmix64(seed ^ 0xEA27) ^ day);
@@ -110,14 +110,24 @@ fn stats_tool_reproduces_the_real_image_readme() {
     let t: Vec<f64> = frame
         .pixels
         .iter()
-        .map(|&v| if v == 0 { f64::NAN } else { f64::from(v) / 50.0 })
+        .map(|&v| {
+            if v == 0 {
+                f64::NAN
+            } else {
+                f64::from(v) / 50.0
+            }
+        })
         .collect();
     let s = TextureStats::of(&t, frame.width, frame.height, PATCH_PX_KM).expect("stats");
     assert_eq!(s.step2_k, [0.5, 4.0, 11.0, 44.0]);
     assert!((s.step2_share_over[0] - 0.063).abs() < 0.001);
     assert!((s.step2_share_over[1] - 0.012).abs() < 0.0005);
     assert!((s.step2_share_over[2] - 0.0012).abs() < 0.0001);
-    assert!((s.spectral_slope + 2.7).abs() < 0.05, "{}", s.spectral_slope);
+    assert!(
+        (s.spectral_slope + 2.7).abs() < 0.05,
+        "{}",
+        s.spectral_slope
+    );
     assert_eq!(s.bt_k, [259.5, 292.0, 296.0]);
 }
 
@@ -144,7 +154,10 @@ fn texture_statistics_within_the_acceptance_ranges() {
         0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2])
     };
     let (p, s, k) = (median(&mut p99), median(&mut share), median(&mut slope));
-    eprintln!("median p99 {p} K, share > 10 K {:.2} %, slope {k:.2}", 100.0 * s);
+    eprintln!(
+        "median p99 {p} K, share > 10 K {:.2} %, slope {k:.2}",
+        100.0 * s
+    );
     assert!((9.0..=17.0).contains(&p), "p99 {p}");
     assert!((0.008..=0.035).contains(&s), "share {s}");
     assert!((-3.3..=-2.5).contains(&k), "slope {k}");

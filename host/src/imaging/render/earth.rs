@@ -104,6 +104,8 @@ impl EarthRays<'_> {
 }
 
 /// Adds the Earth's signal behind the target; returns how many pixel centres see it.
+// The frame's buffers and settings, passed apart so the caller keeps its borrows.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn render_earth(
     cam: &Pinhole,
     earth: &EarthView<'_>,
