@@ -27,7 +27,9 @@
 //!   (more or less cloud where the noise realisation has too little or too much); s
 //!   scales the whole temperature only for the rest δ cannot reach (within
 //!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`BORDER_BLEND_DEG`] of a cell border δ
-//!   and s blend with the neighbour's (smoothstep), so the field is continuous.
+//!   and s blend with the neighbour's (smoothstep), so the field is continuous. Three
+//!   passes, each lazy per cell: δ of the cell alone; δ again with the neighbours'
+//!   first δ blended in; s from the mean with every final δ blended as rendered.
 //!
 //! The field is a deterministic function of (latitude, longitude, day, seed): the
 //! octaves' rotations and offsets come from (seed, day), the lattice values from the
@@ -116,12 +118,10 @@ struct Cell {
     shift: f64,
 }
 
-/// A cell's final balance: its own threshold shift given its neighbours' blended in,
-/// and the scale s of the rest.
+/// A cell's final threshold shift, given its neighbours' (stand-alone) blended in.
 #[derive(Debug, Clone, Copy)]
 struct Balance {
     shift: f64,
-    scale_s: f64,
 }
 
 /// A point's texture inputs before its cell's threshold shift.
@@ -145,6 +145,7 @@ pub struct CloudField {
     clear_t_k: Vec<f64>,
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
+    scale: Vec<OnceLock<f64>>,
 }
 
 impl Clone for CloudField {
@@ -158,6 +159,7 @@ impl Clone for CloudField {
             clear_t_k: self.clear_t_k.clone(),
             cells: self.cells.clone(),
             balance: self.balance.clone(),
+            scale: self.scale.clone(),
         }
     }
 }
@@ -272,6 +274,9 @@ impl CloudField {
                 .map(|_| OnceLock::new())
                 .collect(),
             balance: (0..OlrGrid::ROWS * OlrGrid::COLS)
+                .map(|_| OnceLock::new())
+                .collect(),
+            scale: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
                 .collect(),
         };
@@ -400,6 +405,46 @@ impl CloudField {
         *self.balance[row * OlrGrid::COLS + col].get_or_init(|| self.build_balance(row, col))
     }
 
+    /// The cell's scale s: its flux over the mean σT⁴ with the final blended shifts,
+    /// to the ¼ power (measured on the balance points, as the renderer blends).
+    fn scale_s(&self, row: usize, col: usize) -> f64 {
+        *self.scale[row * OlrGrid::COLS + col].get_or_init(|| {
+            let cell = self.cell(row, col);
+            let own = self.balance(row, col).shift;
+            let mut nb = [[own; 3]; 3];
+            for (dr, line) in nb.iter_mut().enumerate() {
+                for (dc, v) in line.iter_mut().enumerate() {
+                    if dr != 1 || dc != 1 {
+                        let (r, c) = Self::neighbour(row, col, dr, dc);
+                        *v = self.balance(r, c).shift;
+                    }
+                }
+            }
+            let pts = self.balance_points(cell, row, col);
+            let (mut sum, mut wsum) = (0.0, 0.0);
+            for (p, w, u, v) in &pts {
+                let (wy, wx) = (
+                    blend_weights(*u, SHIFT_BLEND_DEG),
+                    blend_weights(*v, SHIFT_BLEND_DEG),
+                );
+                let mut shift = 0.0;
+                for (dr, wyr) in wy.iter().enumerate() {
+                    for (dc, wxc) in wx.iter().enumerate() {
+                        shift += wyr * wxc * nb[dr][dc];
+                    }
+                }
+                sum += w * STEFAN_BOLTZMANN_W_M2_K4 * self.temperature(p, shift).powi(4);
+                wsum += w;
+            }
+            let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
+            if sum > 0.0 {
+                (target / (sum / wsum)).sqrt().sqrt()
+            } else {
+                1.0
+            }
+        })
+    }
+
     /// Cell (row + dr, col + dc): rows clamped at the poles, columns wrapped.
     fn neighbour(row: usize, col: usize, dr: usize, dc: usize) -> (usize, usize) {
         let r = (row + dr).saturating_sub(1).min(OlrGrid::ROWS - 1);
@@ -518,14 +563,8 @@ impl CloudField {
             })
             .collect();
         let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
-        let (shift, f) = self.solve_shift(&pts, &ab, target);
         Balance {
-            shift,
-            scale_s: if f > 0.0 {
-                (target / f).sqrt().sqrt()
-            } else {
-                1.0
-            },
+            shift: self.solve_shift(&pts, &ab, target).0,
         }
     }
 
@@ -574,7 +613,7 @@ impl CloudField {
         let cell = self.cell(row, col);
         let point = self.point_at(cell, lat, lon, u, v, p);
         let own = self.balance(row, col);
-        let (mut shift, mut s) = (own.shift, own.scale_s);
+        let (mut shift, mut s) = (own.shift, self.scale_s(row, col));
         let b = SHIFT_BLEND_DEG;
         if u < b || u > 1.0 - b || v < b || v > 1.0 - b {
             let (wy, wx) = (blend_weights(u, b), blend_weights(v, b));
@@ -589,14 +628,17 @@ impl CloudField {
                     if w == 0.0 && ws == 0.0 {
                         continue;
                     }
-                    let nb = if dr == 1 && dc == 1 {
-                        own
-                    } else {
-                        let (r, c) = Self::neighbour(row, col, dr, dc);
-                        self.balance(r, c)
-                    };
-                    ks += w * nb.shift;
-                    ss += ws * nb.scale_s;
+                    let (r, c) = Self::neighbour(row, col, dr, dc);
+                    if w != 0.0 {
+                        ks += w * if dr == 1 && dc == 1 {
+                            own.shift
+                        } else {
+                            self.balance(r, c).shift
+                        };
+                    }
+                    if ws != 0.0 {
+                        ss += ws * self.scale_s(r, c);
+                    }
                 }
             }
             shift = ks;
