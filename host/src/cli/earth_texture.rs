@@ -118,6 +118,18 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
                 }
             }
         }
+        // Per-point cost with the patch's cells already built (a rendered frame's
+        // steady state), single thread.
+        let field = builtin_field(args.seed, 0);
+        let (lat, lon) = PATCH_CENTRES[0];
+        let n = args.size * args.size;
+        let cold = std::time::Instant::now();
+        let _ = sample_patch(&field, lat, lon, args.size, args.size, PATCH_PX_KM, 0.0);
+        let cold_ns = cold.elapsed().as_nanos() as f64 / n as f64;
+        let warm = std::time::Instant::now();
+        let _ = sample_patch(&field, lat, lon, args.size, args.size, PATCH_PX_KM, 0.0);
+        let warm_ns = warm.elapsed().as_nanos() as f64 / n as f64;
+        eprintln!("texture cost: {cold_ns:.0} ns per point with cell set-up, {warm_ns:.0} ns warm");
         if let Some((w, h, t)) = &real {
             if let Some(s) = TextureStats::of(t, *w, *h, PATCH_PX_KM) {
                 println!("{}", row("real (valid pixels)", &s));
