@@ -24,6 +24,7 @@ use clap::{Parser, Subcommand};
 
 pub mod demo;
 pub mod detect;
+pub mod earth_texture;
 pub mod eval;
 pub mod fixtures;
 pub mod memory;
@@ -118,6 +119,11 @@ pub enum Command {
     /// stdout; every trial in --out/trials.csv. Bad input: one line
     /// `tirroi: error: ...`, exit code 2.
     Tune(tune::TuneArgs),
+    /// Statistics of the Earth's cloud texture (`earth_model.texture = "clouds"`) at
+    /// 4 km per pixel: 2-px steps, their shares over 5/10/20 K, the 2-D spectral slope
+    /// (8-200 km) and BT percentiles, beside a real longwave image (--real PNG, value =
+    /// BT x 50); --preview writes ours and the real image side by side (220-300 K).
+    EarthTexture(earth_texture::EarthTextureArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -137,6 +143,7 @@ pub fn main() -> ExitCode {
         Command::Paper(args) => exit_code(paper::run(&args)),
         Command::Tune(args) => exit_code(tune::run(&args)),
         Command::Render(args) => exit_code(render::run(&args)),
+        Command::EarthTexture(args) => exit_code(earth_texture::run(&args)),
     }
 }
 

@@ -17,10 +17,11 @@ use crate::imaging::render::{
 use crate::imaging::signature::{Calibration, SensorSignature};
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
-use crate::world::earth::{EarthMap, OlrGrid};
+use crate::world::earth::{CloudField, EarthMap, OlrGrid};
 use crate::world::geom::{normalize, scale};
 use crate::world::scene::{
-    Camera, EarthSource, Illumination, RadiometryReadout, SceneFile, SignatureKind, TargetModel,
+    Camera, EarthSource, EarthTexture, Illumination, RadiometryReadout, SceneFile, SignatureKind,
+    TargetModel,
 };
 use crate::world::spacecraft::thermal::{TRANSIENT_STEP_S, facet_heat_capacities_j_k};
 use crate::world::spacecraft::{
@@ -181,12 +182,23 @@ impl Library {
             .par_iter()
             .map(|&(ill, day)| {
                 let grid = &grids[&day];
-                let map = match ill {
-                    Illumination::Sunlit => EarthMap::refine(grid, file.earth_model.mesh_deg, &lut),
+                let scaled;
+                let grid = match ill {
+                    Illumination::Sunlit => grid,
                     Illumination::Eclipse => {
-                        EarthMap::refine(&grid.scaled(factor), file.earth_model.mesh_deg, &lut)
+                        scaled = grid.scaled(factor);
+                        &scaled
                     }
                 };
+                let map = EarthMap::refine(grid, file.earth_model.mesh_deg, &lut).map(|m| {
+                    match file.earth_model.texture {
+                        EarthTexture::Paper => m,
+                        // The same clouds by day and seed, whatever the illumination.
+                        EarthTexture::Clouds => {
+                            m.with_clouds(CloudField::new(grid, day as u64, file.dataset.seed))
+                        }
+                    }
+                });
                 map.map(|m| ((ill, day), Arc::new(m)))
                     .map_err(|e| DatasetError(format!("Earth map: {e}")))
             })

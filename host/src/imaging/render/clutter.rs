@@ -152,6 +152,7 @@ pub fn signal_to_clutter(
         render_earth(
             &crop,
             earth,
+            input.lut,
             input.readout,
             &none,
             &mut twin,

@@ -354,6 +354,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
         earth_px = render_earth(
             &cam,
             earth,
+            input.lut,
             input.readout,
             &coverage,
             &mut signal,

@@ -18,13 +18,16 @@ use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
 mod builtin;
 #[cfg(feature = "netcdf")]
 mod ceres;
+pub mod clouds;
 mod error;
 mod grid;
 mod refine;
 #[cfg(test)]
 mod tests;
+pub mod texture_stats;
 
 pub use builtin::BUILTIN_ZONAL_OLR_W_M2;
+pub use clouds::CloudField;
 pub use error::EarthError;
 pub use grid::interpolate_temperature_k;
 
@@ -101,4 +104,6 @@ pub struct EarthMap {
     node_temps: Vec<f32>,
     /// Smallest and largest cell radiance.
     min_max: (f32, f32),
+    /// The sub-grid cloud texture (`earth_model.texture = "clouds"`), if any.
+    clouds: Option<Box<clouds::CloudField>>,
 }

@@ -73,7 +73,22 @@ impl EarthMap {
             temperature,
             node_temps,
             min_max,
+            clouds: None,
         })
+    }
+
+    /// This map with the sub-grid cloud texture `clouds` (built from the same grid):
+    /// the renderer then takes every ray's temperature from it
+    /// ([`CloudField::temperature_k`](super::CloudField::temperature_k)) instead of the
+    /// mesh cell.
+    pub fn with_clouds(mut self, clouds: super::CloudField) -> EarthMap {
+        self.clouds = Some(Box::new(clouds));
+        self
+    }
+
+    /// The cloud texture, if the map has one.
+    pub fn clouds(&self) -> Option<&super::CloudField> {
+        self.clouds.as_deref()
     }
 
     /// The mesh size, degrees per cell (1/k).

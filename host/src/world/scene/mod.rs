@@ -53,8 +53,8 @@ mod tests;
 pub use camera::{Camera, RadiometryReadout, ResponseName, SignatureKind};
 pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
 pub use spec::{
-    DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, MAX_OFFSET_FRACTION,
-    SceneSpec,
+    DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, EarthTexture,
+    MAX_OFFSET_FRACTION, SceneSpec,
 };
 
 /// A scene/dataset description: what a TOML file or a preset holds.

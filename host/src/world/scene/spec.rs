@@ -23,6 +23,20 @@ pub enum EarthSource {
     Netcdf,
 }
 
+/// How the Earth looks below the 1° flux grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EarthTexture {
+    /// The paper's: the 1° Eq. 10 temperatures interpolated to the `mesh_deg` mesh,
+    /// flat per mesh cell, the view factor's cos of the emission angle at the limb.
+    #[default]
+    Paper,
+    /// Sub-grid cloud texture ([`crate::world::earth::CloudField`]): sharp-edged cloud
+    /// fields conserving each 1° cell's flux, limb darkening and a thin atmospheric
+    /// edge beyond the limb.
+    Clouds,
+}
+
 /// The Earth model shared by every scene of a file (Section 3.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -43,6 +57,8 @@ pub struct EarthModel {
     pub eclipse_factor: f32,
     /// Earth radius, km.
     pub radius_km: f64,
+    /// Sub-grid texture: "paper" (default) or "clouds".
+    pub texture: EarthTexture,
 }
 
 impl Default for EarthModel {
@@ -56,6 +72,7 @@ impl Default for EarthModel {
             mesh_deg: EarthMap::DEFAULT_MESH_DEG,
             eclipse_factor: ECLIPSE_FLUX_FACTOR,
             radius_km: EARTH_RADIUS_M / 1e3,
+            texture: EarthTexture::Paper,
         }
     }
 }

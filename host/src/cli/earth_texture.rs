@@ -1,0 +1,161 @@
+//! `tirroi earth-texture`: statistics of the Earth's cloud texture at 4 km per pixel
+//! beside those of real longwave imagery, and side-by-side previews.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use image::{GrayImage, Luma};
+
+use crate::imaging::image_io::read_frame;
+use crate::seed::splitmix64;
+use crate::world::earth::texture_stats::{PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch};
+use crate::world::earth::{CloudField, OlrGrid};
+
+/// Arguments of `tirroi earth-texture`.
+#[derive(Debug, Args)]
+pub struct EarthTextureArgs {
+    /// Print the statistics table (2-px steps, shares, spectral slope, BT percentiles).
+    #[arg(long)]
+    pub stats: bool,
+    /// A real 16-bit PNG (value = BT × 50, 0 = no data) to measure the same way, on its
+    /// largest all-valid rectangle.
+    #[arg(long)]
+    pub real: Option<PathBuf>,
+    /// Write a side-by-side preview (ours | real, 220–300 K greyscale) to this PNG.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+    /// Dataset seed (the built-in OLR grid and the texture derive from it).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Days (built-in OLR grid and texture) to sample.
+    #[arg(long, default_value_t = 2)]
+    pub days: u64,
+    /// Patch size, pixels (square).
+    #[arg(long, default_value_t = 512)]
+    pub size: usize,
+}
+
+/// Patch centres (latitude°, longitude° E) the statistics sample: the Hawaii sector of
+/// the real scene, the subtropical Atlantic, the warm pool and a mid-latitude storm track.
+pub const PATCH_CENTRES: [(f64, f64); 4] =
+    [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
+
+/// Greyscale of the previews: 220 K black, 300 K white.
+const GREY_K: (f64, f64) = (220.0, 300.0);
+
+fn grey(t: f64) -> u8 {
+    ((t - GREY_K.0) / (GREY_K.1 - GREY_K.0) * 255.0).clamp(0.0, 255.0) as u8
+}
+
+/// The texture of the built-in grid of (seed, day), as the dataset library makes it.
+pub fn builtin_field(seed: u64, day: u64) -> CloudField {
+    let grid = OlrGrid::builtin(splitmix64(seed ^ 0xEA27) ^ day);
+    CloudField::new(&grid, day, seed)
+}
+
+fn row(name: &str, s: &TextureStats) -> String {
+    format!(
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} |",
+        s.step2_k[0],
+        s.step2_k[1],
+        s.step2_k[2],
+        s.step2_k[3],
+        100.0 * s.step2_share_over[0],
+        100.0 * s.step2_share_over[1],
+        100.0 * s.step2_share_over[2],
+        s.spectral_slope,
+        s.bt_k[0],
+        s.bt_k[1],
+        s.bt_k[2],
+    )
+}
+
+/// The real image: (w, h, BT or NaN per pixel).
+fn read_real(path: &Path) -> Result<(usize, usize, Vec<f64>), String> {
+    let f = read_frame(path, Some(16)).map_err(|e| e.to_string())?;
+    let t = f
+        .pixels
+        .iter()
+        .map(|&v| {
+            if v == 0 {
+                f64::NAN
+            } else {
+                f64::from(v) / 50.0
+            }
+        })
+        .collect();
+    Ok((f.width, f.height, t))
+}
+
+/// Runs the command.
+///
+/// # Errors
+/// A message naming the file that could not be read or written.
+pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
+    if args.size < 64 {
+        return Err(format!("--size {}: expected at least 64 px", args.size));
+    }
+    let real = args.real.as_deref().map(read_real).transpose()?;
+    if args.stats {
+        println!(
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K |"
+        );
+        println!("|---|---|---|---|---|");
+        for day in 0..args.days {
+            let field = builtin_field(args.seed, day);
+            for &(lat, lon) in &PATCH_CENTRES {
+                let t = sample_patch(
+                    &field,
+                    lat,
+                    lon,
+                    args.size,
+                    args.size,
+                    PATCH_PX_KM,
+                    REAL_QUANTUM_K,
+                );
+                if let Some(s) = TextureStats::of(&t, args.size, args.size, PATCH_PX_KM) {
+                    println!("{}", row(&format!("ours day {day} ({lat}°, {lon}°)"), &s));
+                }
+            }
+        }
+        // Per-point cost with the patch's cells already built (a rendered frame's
+        // steady state), single thread.
+        let field = builtin_field(args.seed, 0);
+        let (lat, lon) = PATCH_CENTRES[0];
+        let n = args.size * args.size;
+        let cold = std::time::Instant::now();
+        let _ = sample_patch(&field, lat, lon, args.size, args.size, PATCH_PX_KM, 0.0);
+        let cold_ns = cold.elapsed().as_nanos() as f64 / n as f64;
+        let warm = std::time::Instant::now();
+        let _ = sample_patch(&field, lat, lon, args.size, args.size, PATCH_PX_KM, 0.0);
+        let warm_ns = warm.elapsed().as_nanos() as f64 / n as f64;
+        eprintln!("texture cost: {cold_ns:.0} ns per point with cell set-up, {warm_ns:.0} ns warm");
+        if let Some((w, h, t)) = &real {
+            if let Some(s) = TextureStats::of(t, *w, *h, PATCH_PX_KM) {
+                println!("{}", row("real (valid pixels)", &s));
+            }
+        }
+    }
+    if let Some(out) = &args.preview {
+        let (w, h) = real.as_ref().map_or((args.size, args.size), |r| (r.0, r.1));
+        let field = builtin_field(args.seed, 0);
+        let (lat, lon) = PATCH_CENTRES[0];
+        let ours = sample_patch(&field, lat, lon, w, h, PATCH_PX_KM, REAL_QUANTUM_K);
+        let gap = 8;
+        let total_w = if real.is_some() { 2 * w + gap } else { w };
+        let mut img = GrayImage::from_pixel(total_w as u32, h as u32, Luma([0]));
+        for y in 0..h {
+            for x in 0..w {
+                img.put_pixel(x as u32, y as u32, Luma([grey(ours[y * w + x])]));
+                if let Some((_, _, t)) = &real {
+                    let v = t[y * w + x];
+                    let g = if v.is_finite() { grey(v) } else { 0 };
+                    img.put_pixel((w + gap + x) as u32, y as u32, Luma([g]));
+                }
+            }
+        }
+        img.save(out)
+            .map_err(|e| format!("{}: cannot write: {e}", out.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,659 @@
+//! Sub-grid cloud texture of the Earth ([`CloudField`], `earth_model.texture =
+//! "clouds"`): an energy-conserving stochastic downscaling of the 1° OLR grid to the
+//! camera's ~4 km pixels.
+//!
+//! At every point the brightness temperature is
+//!
+//! T = s · (T_clear + grain − min(m · ΔT_local, [`MAX_CLOUD_COLD_K`]))
+//!
+//! - T_clear(φ): the Eq. 10 temperature of the clear-sky zonal OLR climatology
+//!   (`CLEAR_SKY_OLR_W_M2`, CERES EBAF), smooth in latitude;
+//! - the cloud partition comes from the flux F̃ (the 1° fluxes interpolated bilinearly
+//!   between cell centres, so no parameter jumps at cell borders): the share of clear
+//!   flux that is missing, r = 1 − F̃/F_clear, sets the cloud fraction
+//!   c = min(√(r / [`OVERCAST_DEFICIT`]), [`MAX_CLOUD_FRACTION`]) and a mean
+//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 10…80 K colder than
+//!   the clear surface;
+//! - m = a steep smoothstep of (n − θ): n is a fractal field (value noise on the 3-D
+//!   unit sphere × Earth radius, so there is no seam and no pole singularity; octaves
+//!   with lattices of [`OCTAVE_LATTICE_KM`], amplitude ratio [`OCTAVE_GAIN`], the coarse
+//!   ones stretched north–south so that bands run east–west) and θ its (1 − c)
+//!   quantile, so about a share c of the area is cloudy; the transition width
+//!   [`EDGE_WIDTH_SIGMA`] gives 1–3 px cloud edges at 4 km per pixel;
+//! - ΔT_local grows from 0.5 ΔT at a cloud's edge to 1.5 ΔT in its core; the edge
+//!   width grows with ΔT (cold high-cloud fringes are softer than low-cloud edges);
+//! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
+//!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
+//!   (more or less cloud where the noise realisation has too little or too much); s
+//!   scales the whole temperature only for the rest δ cannot reach (within
+//!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`BORDER_BLEND_DEG`] of a cell border δ
+//!   and s blend with the neighbour's (smoothstep), so the field is continuous. Three
+//!   passes, each lazy per cell: δ of the cell alone; δ again with the neighbours'
+//!   first δ blended in; s from the mean with every final δ blended as rendered.
+//!
+//! The field is a deterministic function of (latitude, longitude, day, seed): the
+//! octaves' rotations and offsets come from (seed, day), the lattice values from the
+//! seed. Per 1° cell, the coarse octaves on a 9 × 9 node grid and (δ, s) are computed
+//! once, on first use (thread-safe; the values do not depend on which thread or which
+//! order), so a frame pays for the cells it sees.
+
+use std::sync::OnceLock;
+
+use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
+use tirroi_core::sensor::rng::Xoshiro128pp;
+
+use super::OlrGrid;
+use super::builtin::{CLEAR_SKY_OLR_W_M2, profile};
+use super::flux_to_temperature_k;
+
+/// Mean Earth radius the noise lives on, km (the lattice sizes are in km on it).
+pub const NOISE_RADIUS_KM: f64 = 6371.0;
+/// Kilometres per degree of latitude on [`NOISE_RADIUS_KM`].
+pub const KM_PER_DEG: f64 = NOISE_RADIUS_KM * std::f64::consts::PI / 180.0;
+/// Lattice spacing of each noise octave, km: the first [`COARSE_OCTAVES`] are cached per
+/// 1° cell on a 1/8° node grid and interpolated; the rest are evaluated per ray.
+pub const OCTAVE_LATTICE_KM: [f64; 7] = [400.0, 200.0, 100.0, 50.0, 25.0, 12.0, 6.0];
+/// Octaves cached per cell (lattices ≥ 100 km, sampled every 1/8° ≈ 14 km).
+pub const COARSE_OCTAVES: usize = 3;
+/// Amplitude ratio of successive octaves (halving lattices): sets the spectral slope of
+/// the cloud interiors; the sharp edges set the rest.
+pub const OCTAVE_GAIN: f64 = 0.7;
+/// North–south compression of the coarse octaves (their features run east–west, as
+/// frontal cloud bands and cirrus streets).
+pub const ZONAL_STRETCH: f64 = 2.0;
+/// Width of the cloud-edge transition in units of the noise's standard deviation.
+pub const EDGE_WIDTH_SIGMA: f64 = 0.08;
+/// Missing clear-sky flux share r at which a point is overcast: the cloud fraction is
+/// c = √(r / r_overcast), so thin deficits come as many shallow (low) clouds and large
+/// ones as deep, wide decks (r = 0.05: 41 % cloud 10 K colder; r = 0.45: 95 %, 45 K).
+pub const OVERCAST_DEFICIT: f64 = 0.3;
+/// Largest cloud fraction of a point (overcast decks keep some gaps).
+pub const MAX_CLOUD_FRACTION: f64 = 0.95;
+/// Cloud tops are at least this much colder than the clear surface, K.
+pub const MIN_CLOUD_COLD_K: f64 = 10.0;
+/// ... and at most this much, K (also the cap of the texture's local depth).
+pub const MAX_CLOUD_COLD_K: f64 = 80.0;
+/// Peak-to-peak amplitude of the clear-sky grain (unresolved trade cumulus, surface
+/// and humidity texture), K.
+pub const CLEAR_GRAIN_K: f64 = 2.0;
+/// Half-width of the band along each cell border where (δ, s) blend with the
+/// neighbour cell's, degrees (0.05° ≈ 5.6 km of latitude: about 3 px at 4 km).
+pub const BORDER_BLEND_DEG: f64 = 0.05;
+/// Half-width of the band along each cell border where the cloud threshold shift
+/// blends with the neighbour's, degrees (0.35°: the threshold changes smoothly over
+/// 80 km, so no cloud is cut along a cell border).
+pub const SHIFT_BLEND_DEG: f64 = 0.35;
+/// Sample points per axis of a cell's energy balance (16 × 16, cell-centred).
+pub const BALANCE_SAMPLES: usize = 16;
+/// Largest shift of a cell's cloud threshold its balance may use, noise σ.
+pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 6.0;
+/// Margin of the local clear sky above the Eq. 10 temperature of the interpolated flux,
+/// K: where a cell is warmer than the clear-sky climatology its clear sky warms with it.
+pub const CLEAR_MARGIN_K: f64 = 1.0;
+/// Coarse node grid per cell axis (1/8° spacing, both borders included).
+const NODES: usize = 9;
+/// Lattice table side (values repeat every 32 lattice cells; each octave is rotated and
+/// offset differently, so the repeat never lines up).
+const TABLE: usize = 32;
+/// Quantiles kept of the noise's distribution.
+const QUANTILES: usize = 256;
+/// Random directions the noise's distribution is measured on.
+const DISTRIBUTION_SAMPLES: usize = 8192;
+
+/// One noise octave: rotation (rows), frequency and offset.
+#[derive(Debug, Clone)]
+struct Octave {
+    rot: [[f64; 3]; 3],
+    inv_lattice_km: f64,
+    stretch: f64,
+    offset: [f64; 3],
+    amplitude: f64,
+}
+
+/// What a cell caches: coarse noise at its 9 × 9 nodes and its balance factors.
+#[derive(Debug, Clone)]
+struct Cell {
+    coarse: [f32; NODES * NODES],
+    /// Threshold shift balancing the cell on its own (no blending), σ units × σ.
+    shift: f64,
+}
+
+/// A cell's final threshold shift, given its neighbours' (stand-alone) blended in.
+#[derive(Debug, Clone, Copy)]
+struct Balance {
+    shift: f64,
+}
+
+/// A point's texture inputs before its cell's threshold shift.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    t_clear: f64,
+    dt: f64,
+    theta: f64,
+    n: f64,
+}
+
+/// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
+/// before use (the per-cell caches are cloned with it).
+#[derive(Debug)]
+pub struct CloudField {
+    flux: Vec<f32>,
+    table: Vec<f32>,
+    octaves: Vec<Octave>,
+    quantiles: [f64; QUANTILES + 1],
+    sigma: f64,
+    clear_t_k: Vec<f64>,
+    cells: Vec<OnceLock<Box<Cell>>>,
+    balance: Vec<OnceLock<Balance>>,
+    scale: Vec<OnceLock<f64>>,
+}
+
+impl Clone for CloudField {
+    fn clone(&self) -> Self {
+        CloudField {
+            flux: self.flux.clone(),
+            table: self.table.clone(),
+            octaves: self.octaves.clone(),
+            quantiles: self.quantiles,
+            sigma: self.sigma,
+            clear_t_k: self.clear_t_k.clone(),
+            cells: self.cells.clone(),
+            balance: self.balance.clone(),
+            scale: self.scale.clone(),
+        }
+    }
+}
+
+/// Clear-sky table step, degrees of latitude.
+const CLEAR_STEP_DEG: f64 = 0.1;
+
+/// Weights of the (previous, own, next) cell at fraction `t` ∈ [0, 1] of a cell along
+/// one axis: ½ on a border, smoothly 0 at `width` (cell fractions) inside.
+fn blend_weights(t: f64, width: f64) -> [f64; 3] {
+    let side = |d: f64| 0.5 * smoothstep(1.0 - d / width);
+    let (a, c) = (side(t), side(1.0 - t));
+    [a, 1.0 - a - c, c]
+}
+
+fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+/// Unit vector of (lat, lon) in the Earth-fixed frame (z north, x at longitude 0).
+pub fn unit_vector(lat_deg: f64, lon_deg: f64) -> [f64; 3] {
+    let (sl, cl) = (
+        libm::sin(lat_deg.to_radians()),
+        libm::cos(lat_deg.to_radians()),
+    );
+    let (so, co) = (
+        libm::sin(lon_deg.to_radians()),
+        libm::cos(lon_deg.to_radians()),
+    );
+    [cl * co, cl * so, sl]
+}
+
+impl CloudField {
+    /// The texture of `grid` (W m⁻², the map's own, eclipse-scaled if so) for `day` and
+    /// `seed`. Costs ~10 ms (the noise's distribution); cells are filled on use.
+    pub fn new(grid: &OlrGrid, day: u64, seed: u64) -> CloudField {
+        let mut rng = Xoshiro128pp::seed_from_u64(crate::seed::splitmix64(seed ^ 0xC10D_5EED));
+        let table: Vec<f32> = (0..TABLE * TABLE * TABLE)
+            .map(|_| (f64::from(rng.next_u32()) / f64::from(u32::MAX) * 2.0 - 1.0) as f32)
+            .collect();
+        let mut drng = Xoshiro128pp::seed_from_u64(crate::seed::splitmix64(
+            seed ^ crate::seed::splitmix64(day.wrapping_add(0xDA7)),
+        ));
+        let mut unif = || f64::from(drng.next_u32()) / 4_294_967_296.0;
+        let mut amplitude = 1.0;
+        let octaves: Vec<Octave> = OCTAVE_LATTICE_KM
+            .iter()
+            .enumerate()
+            .map(|(i, &l)| {
+                // A uniformly random rotation from a random unit quaternion (Shoemake).
+                let (u1, u2, u3) = (unif(), unif(), unif());
+                let tau = 2.0 * std::f64::consts::PI;
+                let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+                let q = [
+                    a * libm::sin(tau * u2),
+                    a * libm::cos(tau * u2),
+                    b * libm::sin(tau * u3),
+                    b * libm::cos(tau * u3),
+                ];
+                let [x, y, z, w] = q;
+                let rot = [
+                    [
+                        1.0 - 2.0 * (y * y + z * z),
+                        2.0 * (x * y - z * w),
+                        2.0 * (x * z + y * w),
+                    ],
+                    [
+                        2.0 * (x * y + z * w),
+                        1.0 - 2.0 * (x * x + z * z),
+                        2.0 * (y * z - x * w),
+                    ],
+                    [
+                        2.0 * (x * z - y * w),
+                        2.0 * (y * z + x * w),
+                        1.0 - 2.0 * (x * x + y * y),
+                    ],
+                ];
+                let offset = [unif() * 1e3, unif() * 1e3, unif() * 1e3];
+                let o = Octave {
+                    rot,
+                    inv_lattice_km: 1.0 / l,
+                    stretch: if i < COARSE_OCTAVES {
+                        ZONAL_STRETCH
+                    } else {
+                        1.0
+                    },
+                    offset,
+                    amplitude,
+                };
+                amplitude *= OCTAVE_GAIN;
+                o
+            })
+            .collect();
+        let rows = (180.0 / CLEAR_STEP_DEG) as usize + 1;
+        let clear_t_k = (0..rows)
+            .map(|i| {
+                flux_to_temperature_k(profile(
+                    &CLEAR_SKY_OLR_W_M2,
+                    i as f64 * CLEAR_STEP_DEG - 90.0,
+                ))
+            })
+            .collect();
+        let mut field = CloudField {
+            flux: grid.values().to_vec(),
+            table,
+            octaves,
+            quantiles: [0.0; QUANTILES + 1],
+            sigma: 1.0,
+            clear_t_k,
+            cells: (0..OlrGrid::ROWS * OlrGrid::COLS)
+                .map(|_| OnceLock::new())
+                .collect(),
+            balance: (0..OlrGrid::ROWS * OlrGrid::COLS)
+                .map(|_| OnceLock::new())
+                .collect(),
+            scale: (0..OlrGrid::ROWS * OlrGrid::COLS)
+                .map(|_| OnceLock::new())
+                .collect(),
+        };
+        // The noise's distribution on random directions (fixed stream: deterministic).
+        let mut srng = Xoshiro128pp::seed_from_u64(0x5A3F_1E5D);
+        let mut values: Vec<f64> = (0..DISTRIBUTION_SAMPLES)
+            .map(|_| {
+                let z = f64::from(srng.next_u32()) / 4_294_967_296.0 * 2.0 - 1.0;
+                let phi = f64::from(srng.next_u32()) / 4_294_967_296.0 * std::f64::consts::TAU;
+                let r = (1.0 - z * z).sqrt();
+                let p = [r * libm::cos(phi), r * libm::sin(phi), z];
+                field.noise(p, 0..field.octaves.len())
+            })
+            .collect();
+        values.sort_by(f64::total_cmp);
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / values.len() as f64;
+        field.sigma = var.sqrt();
+        for (q, slot) in field.quantiles.iter_mut().enumerate() {
+            let idx = (q * (values.len() - 1)) / QUANTILES;
+            *slot = values[idx];
+        }
+        field
+    }
+
+    /// Sum of the octaves in `range` at unit vector `p`.
+    fn noise(&self, p: [f64; 3], range: std::ops::Range<usize>) -> f64 {
+        let mut sum = 0.0;
+        for o in &self.octaves[range] {
+            let s = NOISE_RADIUS_KM * o.inv_lattice_km;
+            let v = [p[0] * s, p[1] * s, p[2] * s * o.stretch];
+            let q = [
+                o.rot[0][0] * v[0] + o.rot[0][1] * v[1] + o.rot[0][2] * v[2] + o.offset[0],
+                o.rot[1][0] * v[0] + o.rot[1][1] * v[1] + o.rot[1][2] * v[2] + o.offset[1],
+                o.rot[2][0] * v[0] + o.rot[2][1] * v[1] + o.rot[2][2] * v[2] + o.offset[2],
+            ];
+            sum += o.amplitude * self.value_noise(q);
+        }
+        sum
+    }
+
+    /// Trilinear value noise (smoothstep weights) of the lattice table at `q`.
+    #[inline]
+    fn value_noise(&self, q: [f64; 3]) -> f64 {
+        let f = [q[0].floor(), q[1].floor(), q[2].floor()];
+        let t = [q[0] - f[0], q[1] - f[1], q[2] - f[2]];
+        let w = t.map(|t| t * t * (3.0 - 2.0 * t));
+        let m = TABLE as i64 - 1;
+        let i = f.map(|f| (f as i64) & m);
+        let j = i.map(|i| (i + 1) & m);
+        let n = TABLE as i64;
+        let at = |x: i64, y: i64, z: i64| f64::from(self.table[(x + n * (y + n * z)) as usize]);
+        let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
+        let x00 = lerp(at(i[0], i[1], i[2]), at(j[0], i[1], i[2]), w[0]);
+        let x10 = lerp(at(i[0], j[1], i[2]), at(j[0], j[1], i[2]), w[0]);
+        let x01 = lerp(at(i[0], i[1], j[2]), at(j[0], i[1], j[2]), w[0]);
+        let x11 = lerp(at(i[0], j[1], j[2]), at(j[0], j[1], j[2]), w[0]);
+        lerp(lerp(x00, x10, w[1]), lerp(x01, x11, w[1]), w[2])
+    }
+
+    /// Quantile q ∈ [0, 1] of the noise's distribution (linear between the kept ones).
+    fn quantile(&self, q: f64) -> f64 {
+        let x = q.clamp(0.0, 1.0) * QUANTILES as f64;
+        let i = (x as usize).min(QUANTILES - 1);
+        let t = x - i as f64;
+        self.quantiles[i] + (self.quantiles[i + 1] - self.quantiles[i]) * t
+    }
+
+    /// Clear-sky temperature at latitude `lat_deg`, K.
+    fn clear_t(&self, lat_deg: f64) -> f64 {
+        let x = ((lat_deg + 90.0) / CLEAR_STEP_DEG).clamp(0.0, (self.clear_t_k.len() - 1) as f64);
+        let i = (x as usize).min(self.clear_t_k.len() - 2);
+        let t = x - i as f64;
+        self.clear_t_k[i] + (self.clear_t_k[i + 1] - self.clear_t_k[i]) * t
+    }
+
+    /// The 1° flux interpolated bilinearly between cell centres, W m⁻².
+    fn flux_at(&self, lat_deg: f64, lon_deg: f64) -> f64 {
+        let y = (lat_deg + 89.5).clamp(0.0, (OlrGrid::ROWS - 1) as f64);
+        let r0 = (y as usize).min(OlrGrid::ROWS - 2);
+        let ty = y - r0 as f64;
+        let x = lon_deg.rem_euclid(360.0) - 0.5;
+        let fx = x.floor();
+        let tx = x - fx;
+        let n = OlrGrid::COLS as i64;
+        let c0 = (fx as i64).rem_euclid(n) as usize;
+        let c1 = (c0 + 1) % OlrGrid::COLS;
+        let at = |r: usize, c: usize| f64::from(self.flux[r * OlrGrid::COLS + c]);
+        let a = at(r0, c0) + (at(r0, c1) - at(r0, c0)) * tx;
+        let b = at(r0 + 1, c0) + (at(r0 + 1, c1) - at(r0 + 1, c0)) * tx;
+        a + (b - a) * ty
+    }
+
+    /// What a point needs before its cell's threshold shift: (clear temperature with
+    /// grain, K; cloud depth ΔT, K; base threshold θ; noise n).
+    fn point(&self, lat_deg: f64, lon_deg: f64, n: f64, n_fine: f64) -> Point {
+        let f = self.flux_at(lat_deg, lon_deg);
+        let t_clear = self
+            .clear_t(lat_deg)
+            .max(flux_to_temperature_k(f) + CLEAR_MARGIN_K);
+        let f_clear = STEFAN_BOLTZMANN_W_M2_K4 * t_clear.powi(4);
+        let r = (1.0 - f / f_clear).clamp(0.0, 0.9);
+        let c = (r / OVERCAST_DEFICIT).sqrt().min(MAX_CLOUD_FRACTION);
+        let grain = CLEAR_GRAIN_K * (n_fine / self.sigma).clamp(-1.0, 1.0) * 0.5;
+        let (dt, theta) = if c <= 1e-4 {
+            (MIN_CLOUD_COLD_K, self.quantile(1.0 - 1e-4))
+        } else {
+            let f_top = (f_clear - r * f_clear / c).max(1.0);
+            let dt =
+                (t_clear - flux_to_temperature_k(f_top)).clamp(MIN_CLOUD_COLD_K, MAX_CLOUD_COLD_K);
+            (dt, self.quantile(1.0 - c))
+        };
+        Point {
+            t_clear: t_clear + grain,
+            dt,
+            theta,
+            n,
+        }
+    }
+
+    fn cell(&self, row: usize, col: usize) -> &Cell {
+        self.cells[row * OlrGrid::COLS + col].get_or_init(|| Box::new(self.build_cell(row, col)))
+    }
+
+    fn balance(&self, row: usize, col: usize) -> Balance {
+        *self.balance[row * OlrGrid::COLS + col].get_or_init(|| self.build_balance(row, col))
+    }
+
+    /// The cell's scale s: its flux over the mean σT⁴ with the final blended shifts,
+    /// to the ¼ power (measured on the balance points, as the renderer blends).
+    fn scale_s(&self, row: usize, col: usize) -> f64 {
+        *self.scale[row * OlrGrid::COLS + col].get_or_init(|| {
+            let cell = self.cell(row, col);
+            let own = self.balance(row, col).shift;
+            let mut nb = [[own; 3]; 3];
+            for (dr, line) in nb.iter_mut().enumerate() {
+                for (dc, v) in line.iter_mut().enumerate() {
+                    if dr != 1 || dc != 1 {
+                        let (r, c) = Self::neighbour(row, col, dr, dc);
+                        *v = self.balance(r, c).shift;
+                    }
+                }
+            }
+            let pts = self.balance_points(cell, row, col);
+            let (mut sum, mut wsum) = (0.0, 0.0);
+            for (p, w, u, v) in &pts {
+                let (wy, wx) = (
+                    blend_weights(*u, SHIFT_BLEND_DEG),
+                    blend_weights(*v, SHIFT_BLEND_DEG),
+                );
+                let mut shift = 0.0;
+                for (dr, wyr) in wy.iter().enumerate() {
+                    for (dc, wxc) in wx.iter().enumerate() {
+                        shift += wyr * wxc * nb[dr][dc];
+                    }
+                }
+                sum += w * STEFAN_BOLTZMANN_W_M2_K4 * self.temperature(p, shift).powi(4);
+                wsum += w;
+            }
+            let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
+            if sum > 0.0 {
+                (target / (sum / wsum)).sqrt().sqrt()
+            } else {
+                1.0
+            }
+        })
+    }
+
+    /// Cell (row + dr, col + dc): rows clamped at the poles, columns wrapped.
+    fn neighbour(row: usize, col: usize, dr: usize, dc: usize) -> (usize, usize) {
+        let r = (row + dr).saturating_sub(1).min(OlrGrid::ROWS - 1);
+        let c = (col + OlrGrid::COLS + dc - 1) % OlrGrid::COLS;
+        (r, c)
+    }
+
+    /// The cell's 16 × 16 balance points (cell-centred) with their cos φ weights and
+    /// (u, v) fractions.
+    fn balance_points(&self, cell: &Cell, row: usize, col: usize) -> Vec<(Point, f64, f64, f64)> {
+        let (lat0, lon0) = (row as f64 - 90.0, col as f64);
+        let mut pts = Vec::with_capacity(BALANCE_SAMPLES * BALANCE_SAMPLES);
+        for i in 0..BALANCE_SAMPLES {
+            let u = (i as f64 + 0.5) / BALANCE_SAMPLES as f64;
+            let lat = lat0 + u;
+            let w = libm::cos(lat.to_radians());
+            for j in 0..BALANCE_SAMPLES {
+                let v = (j as f64 + 0.5) / BALANCE_SAMPLES as f64;
+                let lon = lon0 + v;
+                let p = self.point_at(cell, lat, lon, u, v, unit_vector(lat, lon));
+                pts.push((p, w, u, v));
+            }
+        }
+        pts
+    }
+
+    /// The shift in [−lim, lim] whose weighted mean σT⁴ of `pts` (shift of point i:
+    /// a_i·δ + b_i) is `target` (bisection: the flux rises with the threshold).
+    fn solve_shift(
+        &self,
+        pts: &[(Point, f64, f64, f64)],
+        ab: &[(f64, f64)],
+        target: f64,
+    ) -> (f64, f64) {
+        let wsum: f64 = pts.iter().map(|p| p.1).sum();
+        let flux_of = |d: f64| {
+            pts.iter()
+                .zip(ab)
+                .map(|((p, w, _, _), (a, b))| {
+                    w * STEFAN_BOLTZMANN_W_M2_K4 * self.temperature(p, a * d + b).powi(4)
+                })
+                .sum::<f64>()
+                / wsum
+        };
+        let lim = MAX_THRESHOLD_SHIFT_SIGMA * self.sigma;
+        let (lo_f, hi_f) = (flux_of(-lim), flux_of(lim));
+        let d = if target <= lo_f {
+            -lim
+        } else if target >= hi_f {
+            lim
+        } else {
+            let (mut lo, mut hi) = (-lim, lim);
+            for _ in 0..26 {
+                let mid = 0.5 * (lo + hi);
+                if flux_of(mid) < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        };
+        (d, flux_of(d))
+    }
+
+    fn build_cell(&self, row: usize, col: usize) -> Cell {
+        let lat0 = row as f64 - 90.0;
+        let lon0 = col as f64;
+        let mut coarse = [0f32; NODES * NODES];
+        for i in 0..NODES {
+            for j in 0..NODES {
+                let lat = lat0 + i as f64 / (NODES - 1) as f64;
+                let lon = lon0 + j as f64 / (NODES - 1) as f64;
+                coarse[i * NODES + j] = self.noise(unit_vector(lat, lon), 0..COARSE_OCTAVES) as f32;
+            }
+        }
+        let mut cell = Cell { coarse, shift: 0.0 };
+        let pts = self.balance_points(&cell, row, col);
+        let ab = vec![(1.0, 0.0); pts.len()];
+        cell.shift = self
+            .solve_shift(&pts, &ab, f64::from(self.flux[row * OlrGrid::COLS + col]))
+            .0;
+        cell
+    }
+
+    /// The final balance: the own shift with the neighbours' (stand-alone) shifts
+    /// blended in as the renderer blends them, then s for the rest.
+    fn build_balance(&self, row: usize, col: usize) -> Balance {
+        let cell = self.cell(row, col);
+        let pts = self.balance_points(cell, row, col);
+        let mut nb = [[0.0f64; 3]; 3];
+        for (dr, line) in nb.iter_mut().enumerate() {
+            for (dc, v) in line.iter_mut().enumerate() {
+                if dr != 1 || dc != 1 {
+                    let (r, c) = Self::neighbour(row, col, dr, dc);
+                    *v = self.cell(r, c).shift;
+                }
+            }
+        }
+        let ab: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|&(_, _, u, v)| {
+                let (wy, wx) = (
+                    blend_weights(u, SHIFT_BLEND_DEG),
+                    blend_weights(v, SHIFT_BLEND_DEG),
+                );
+                let mut b = 0.0;
+                for (dr, wyr) in wy.iter().enumerate() {
+                    for (dc, wxc) in wx.iter().enumerate() {
+                        if dr != 1 || dc != 1 {
+                            b += wyr * wxc * nb[dr][dc];
+                        }
+                    }
+                }
+                (wy[1] * wx[1], b)
+            })
+            .collect();
+        let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
+        Balance {
+            shift: self.solve_shift(&pts, &ab, target).0,
+        }
+    }
+
+    /// Temperature of a point with threshold shift `shift` (before the scale s), K.
+    #[inline]
+    fn temperature(&self, p: &Point, shift: f64) -> f64 {
+        let x = p.n - p.theta - shift;
+        // High (cold, deep) cloud edges are softer than low ones: the width grows with
+        // ΔT (thin cirrus fringes of anvils and fronts).
+        let width = EDGE_WIDTH_SIGMA * self.sigma * (p.dt / MIN_CLOUD_COLD_K).powf(1.25);
+        let m = smoothstep(x / width + 0.5);
+        // Deeper (colder) towards a cloud's core: 0.5 ΔT at the edge, 1.5 ΔT well inside.
+        let core = smoothstep(x / (1.2 * self.sigma));
+        p.t_clear - (m * p.dt * (0.5 + core)).min(MAX_CLOUD_COLD_K)
+    }
+
+    /// The point at fractions (u lat, v lon) of `cell`.
+    fn point_at(&self, cell: &Cell, lat: f64, lon: f64, u: f64, v: f64, p: [f64; 3]) -> Point {
+        let s = (NODES - 1) as f64;
+        let (y, x) = (u * s, v * s);
+        let (i, j) = ((y as usize).min(NODES - 2), (x as usize).min(NODES - 2));
+        let (ty, tx) = (y - i as f64, x - j as f64);
+        let at = |a: usize, b: usize| f64::from(cell.coarse[a * NODES + b]);
+        let a = at(i, j) + (at(i, j + 1) - at(i, j)) * tx;
+        let b = at(i + 1, j) + (at(i + 1, j + 1) - at(i + 1, j)) * tx;
+        let coarse = a + (b - a) * ty;
+        let last = self.octaves.len();
+        let mid = self.noise(p, COARSE_OCTAVES..last - 1);
+        let fine = self.noise(p, last - 1..last);
+        self.point(lat, lon, coarse + mid + fine, fine)
+    }
+
+    /// Brightness temperature of the texture at (`lat_deg`, `lon_deg`), K; `p` is the
+    /// same point's unit vector (z north, x at longitude 0), passed in because the
+    /// renderer has it. Latitude −90…90°, any longitude.
+    pub fn temperature_k(&self, lat_deg: f64, lon_deg: f64, p: [f64; 3]) -> f64 {
+        let lat = lat_deg.clamp(-90.0, 90.0);
+        let lon = if (0.0..360.0).contains(&lon_deg) {
+            lon_deg
+        } else {
+            lon_deg.rem_euclid(360.0)
+        };
+        let row = ((lat + 90.0) as usize).min(OlrGrid::ROWS - 1);
+        let col = (lon as usize).min(OlrGrid::COLS - 1);
+        let (u, v) = (lat + 90.0 - row as f64, lon - col as f64);
+        let cell = self.cell(row, col);
+        let point = self.point_at(cell, lat, lon, u, v, p);
+        let own = self.balance(row, col);
+        let (mut shift, mut s) = (own.shift, self.scale_s(row, col));
+        let b = SHIFT_BLEND_DEG;
+        if u < b || u > 1.0 - b || v < b || v > 1.0 - b {
+            let (wy, wx) = (blend_weights(u, b), blend_weights(v, b));
+            let (ws_y, ws_x) = (
+                blend_weights(u, BORDER_BLEND_DEG),
+                blend_weights(v, BORDER_BLEND_DEG),
+            );
+            let (mut ks, mut ss) = (0.0, 0.0);
+            for dr in 0..3 {
+                for dc in 0..3 {
+                    let (w, ws) = (wy[dr] * wx[dc], ws_y[dr] * ws_x[dc]);
+                    if w == 0.0 && ws == 0.0 {
+                        continue;
+                    }
+                    let (r, c) = Self::neighbour(row, col, dr, dc);
+                    if w != 0.0 {
+                        ks += w * if dr == 1 && dc == 1 {
+                            own.shift
+                        } else {
+                            self.balance(r, c).shift
+                        };
+                    }
+                    if ws != 0.0 {
+                        ss += ws * self.scale_s(r, c);
+                    }
+                }
+            }
+            shift = ks;
+            s = ss;
+        }
+        s * self.temperature(&point, shift)
+    }
+
+    /// [`CloudField::temperature_k`] computing the unit vector itself.
+    pub fn temperature_at_k(&self, lat_deg: f64, lon_deg: f64) -> f64 {
+        self.temperature_k(lat_deg, lon_deg, unit_vector(lat_deg, lon_deg))
+    }
+
+    /// The 1° flux of cell (`row`, `col`) the texture conserves, W m⁻².
+    pub fn cell_flux_w_m2(&self, row: usize, col: usize) -> f32 {
+        self.flux[row.min(OlrGrid::ROWS - 1) * OlrGrid::COLS + col % OlrGrid::COLS]
+    }
+}

@@ -1,0 +1,214 @@
+//! Pixel-scale statistics of a brightness-temperature image ([`TextureStats`]): the
+//! numbers `shared/reference/earth-lwir/README.md` gives for real longwave imagery at
+//! 4 km per pixel, so the cloud texture can be checked against them
+//! (`tirroi earth-texture --stats`).
+
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex;
+
+use super::clouds::{CloudField, KM_PER_DEG};
+
+/// Quantisation step of the real 10.7 µm data above 242 K (GINI counts), K.
+pub const REAL_QUANTUM_K: f64 = 0.5;
+/// Pixel spacing of the real imagery and of our camera from 4 500 km, km.
+pub const PATCH_PX_KM: f64 = 4.0;
+/// Wavelength band of the spectral slope fit, km.
+pub const SLOPE_BAND_KM: (f64, f64) = (8.0, 200.0);
+/// Logarithmic frequency bins over [`SLOPE_BAND_KM`] for the ring average.
+const SLOPE_BINS: usize = 12;
+
+/// Statistics of one image (see the README's table).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TextureStats {
+    /// |T(x+2) − T(x)| along rows: p50, p90, p99 and max, K.
+    pub step2_k: [f64; 4],
+    /// Share of those steps above 5, 10 and 20 K (fractions, 0..=1).
+    pub step2_share_over: [f64; 3],
+    /// Slope of the 2-D ring-averaged power spectrum over [`SLOPE_BAND_KM`].
+    pub spectral_slope: f64,
+    /// Brightness temperature p1, p50, p99, K.
+    pub bt_k: [f64; 3],
+    /// Number of 2-px steps measured.
+    pub steps: usize,
+}
+
+/// The value at quantile `q` (0..=1) of sorted `v` (nearest rank).
+fn pct(v: &[f64], q: f64) -> f64 {
+    let i = ((v.len() - 1) as f64 * q).round() as usize;
+    v[i]
+}
+
+impl TextureStats {
+    /// Statistics of the row-major `w` × `h` image `t_k` (K, NaN = no data) with
+    /// pixels `px_km` apart: steps between valid pixel pairs only, percentiles over the
+    /// valid pixels, the spectrum on the largest all-valid rectangle (as the README's
+    /// numbers were measured). `None` when that rectangle is smaller than 16 × 16.
+    pub fn of(t_k: &[f64], w: usize, h: usize, px_km: f64) -> Option<TextureStats> {
+        if w < 16 || h < 16 || t_k.len() != w * h {
+            return None;
+        }
+        let mut steps: Vec<f64> = Vec::with_capacity((w - 2) * h);
+        for row in t_k.chunks_exact(w) {
+            for x in 0..w - 2 {
+                let d = (row[x + 2] - row[x]).abs();
+                if d.is_finite() {
+                    steps.push(d);
+                }
+            }
+        }
+        let valid: Vec<bool> = t_k.iter().map(|v| v.is_finite()).collect();
+        let (x0, y0, rw, rh) = largest_valid_rectangle(&valid, w, h);
+        if rw < 16 || rh < 16 || steps.is_empty() {
+            return None;
+        }
+        let rect: Vec<f64> = (y0..y0 + rh)
+            .flat_map(|y| t_k[y * w + x0..y * w + x0 + rw].iter().copied())
+            .collect();
+        steps.sort_by(f64::total_cmp);
+        let over =
+            |lim: f64| steps.iter().filter(|&&s| s > lim).count() as f64 / steps.len() as f64;
+        let mut bt: Vec<f64> = t_k.iter().copied().filter(|v| v.is_finite()).collect();
+        bt.sort_by(f64::total_cmp);
+        Some(TextureStats {
+            step2_k: [
+                pct(&steps, 0.5),
+                pct(&steps, 0.9),
+                pct(&steps, 0.99),
+                steps[steps.len() - 1],
+            ],
+            step2_share_over: [over(5.0), over(10.0), over(20.0)],
+            spectral_slope: spectral_slope(&rect, rw, rh, px_km),
+            bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
+            steps: steps.len(),
+        })
+    }
+}
+
+/// Slope of log power vs log frequency of the 2-D ring-averaged power spectrum of the
+/// image (mean removed, Hann window on both axes) over wavelengths [`SLOPE_BAND_KM`]:
+/// the power of all 2-D frequencies is averaged in 12 logarithmic bins of |f| and a
+/// least-squares line fitted through the bins' (log mean |f|, log mean power).
+pub fn spectral_slope(t_k: &[f64], w: usize, h: usize, px_km: f64) -> f64 {
+    let mean = t_k.iter().sum::<f64>() / t_k.len() as f64;
+    let hann = |i: usize, n: usize| {
+        0.5 - 0.5 * (std::f64::consts::TAU * (i as f64 + 0.5) / n as f64).cos()
+    };
+    let mut data: Vec<Complex<f64>> = t_k
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| Complex::new((t - mean) * hann(i % w, w) * hann(i / w, h), 0.0))
+        .collect();
+    let mut planner = FftPlanner::new();
+    let fw = planner.plan_fft_forward(w);
+    for row in data.chunks_exact_mut(w) {
+        fw.process(row);
+    }
+    let fh = planner.plan_fft_forward(h);
+    let mut col = vec![Complex::new(0.0, 0.0); h];
+    for x in 0..w {
+        for y in 0..h {
+            col[y] = data[y * w + x];
+        }
+        fh.process(&mut col);
+        for y in 0..h {
+            data[y * w + x] = col[y];
+        }
+    }
+    let (f_lo, f_hi) = (1.0 / SLOPE_BAND_KM.1, 1.0 / SLOPE_BAND_KM.0);
+    let (l_lo, l_hi) = (f_lo.ln(), f_hi.ln());
+    let mut bins = [(0.0f64, 0.0f64, 0usize); SLOPE_BINS];
+    for y in 0..h {
+        let ky = if y <= h / 2 {
+            y as f64
+        } else {
+            y as f64 - h as f64
+        };
+        for x in 0..w {
+            let kx = if x <= w / 2 {
+                x as f64
+            } else {
+                x as f64 - w as f64
+            };
+            let f = ((kx / (w as f64 * px_km)).powi(2) + (ky / (h as f64 * px_km)).powi(2)).sqrt();
+            if f < f_lo || f > f_hi {
+                continue;
+            }
+            let b = (((f.ln() - l_lo) / (l_hi - l_lo)) * SLOPE_BINS as f64) as usize;
+            let b = b.min(SLOPE_BINS - 1);
+            bins[b].0 += f;
+            bins[b].1 += data[y * w + x].norm_sqr();
+            bins[b].2 += 1;
+        }
+    }
+    let pts: Vec<(f64, f64)> = bins
+        .iter()
+        .filter(|b| b.2 > 0 && b.1 > 0.0)
+        .map(|b| ((b.0 / b.2 as f64).ln(), (b.1 / b.2 as f64).ln()))
+        .collect();
+    let n = pts.len() as f64;
+    let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |a, p| {
+        (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx) * (p.0 - mx))
+    });
+    sxy / sxx
+}
+
+/// The largest axis-aligned rectangle of valid pixels (`valid[y * w + x]`) as
+/// (x0, y0, width, height): the classic histogram-stack method, O(w·h).
+pub fn largest_valid_rectangle(valid: &[bool], w: usize, h: usize) -> (usize, usize, usize, usize) {
+    let mut heights = vec![0usize; w];
+    let mut best = (0, 0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            heights[x] = if valid[y * w + x] { heights[x] + 1 } else { 0 };
+        }
+        let mut stack: Vec<usize> = Vec::new();
+        for x in 0..=w {
+            let cur = if x < w { heights[x] } else { 0 };
+            while let Some(&top) = stack.last() {
+                if heights[top] <= cur {
+                    break;
+                }
+                stack.pop();
+                let hgt = heights[top];
+                let left = stack.last().map_or(0, |&l| l + 1);
+                let width = x - left;
+                if width * hgt > best.2 * best.3 {
+                    best = (left, y + 1 - hgt, width, hgt);
+                }
+            }
+            stack.push(x);
+        }
+    }
+    best
+}
+
+/// The cloud texture on a `w` × `h` patch of `px_km` pixels centred on (`lat0`,
+/// `lon0`) (a local equirectangular grid: x east, y south like an image), brightness
+/// temperature quantised to `quantum_k` (0: not quantised), K, row-major.
+pub fn sample_patch(
+    field: &CloudField,
+    lat0: f64,
+    lon0: f64,
+    w: usize,
+    h: usize,
+    px_km: f64,
+    quantum_k: f64,
+) -> Vec<f64> {
+    let cos0 = libm::cos(lat0.to_radians()).max(0.05);
+    let mut out = Vec::with_capacity(w * h);
+    for y in 0..h {
+        let lat = lat0 - (y as f64 - h as f64 / 2.0) * px_km / KM_PER_DEG;
+        for x in 0..w {
+            let lon = lon0 + (x as f64 - w as f64 / 2.0) * px_km / (KM_PER_DEG * cos0);
+            let t = field.temperature_at_k(lat, lon);
+            out.push(if quantum_k > 0.0 {
+                (t / quantum_k).round() * quantum_k
+            } else {
+                t
+            });
+        }
+    }
+    out
+}
