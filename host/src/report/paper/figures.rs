@@ -24,13 +24,22 @@ pub struct DatasetDirs {
 impl DatasetDirs {
     /// The directories `run` uses for `options`.
     pub fn of(options: &PaperOptions) -> DatasetDirs {
+        DatasetDirs::of_world(options, super::World::Paper)
+    }
+
+    /// The directories of `world`'s two presets (`<preset>` or `<preset>-full`).
+    pub fn of_world(options: &PaperOptions, world: super::World) -> DatasetDirs {
+        let (paper, tango) = world.presets();
+        let dir = |p: &str| {
+            options.out.join(if options.full {
+                format!("{p}-full")
+            } else {
+                p.to_string()
+            })
+        };
         DatasetDirs {
-            paper: options
-                .out
-                .join(if options.full { "paper-full" } else { "paper" }),
-            tango: options
-                .out
-                .join(if options.full { "tango-full" } else { "tango" }),
+            paper: dir(paper),
+            tango: dir(tango),
         }
     }
 }

@@ -99,7 +99,7 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// The built-in presets: name, description, TOML.
-pub const PRESETS: [(&str, &str, &str); 3] = [
+pub const PRESETS: [(&str, &str, &str); 5] = [
     (
         "paper",
         "Section 4.1: 12 000 cube+cylinder images, radiometry (3 material cases) and detection (Scales 1-3), close 15-50 m and far 340-440 m, sunlit and eclipse",
@@ -114,6 +114,16 @@ pub const PRESETS: [(&str, &str, &str); 3] = [
         "quick",
         "24 images across every scene kind (both modes, all material cases and scales, both targets) for a first look",
         include_str!("../../../presets/quick.toml"),
+    ),
+    (
+        "realistic",
+        "the paper's scene kinds in the world a flight detector meets: the real camera's signature, PSF and fixed-gain readout, a cloud-textured Earth, gain/noise/bit-depth variety, edge-cut and 3-12 px targets, the Moon, 10 % frames without a target",
+        include_str!("../../../presets/realistic.toml"),
+    ),
+    (
+        "realistic-tango",
+        "the Tango case study in the realistic world (1 000 radiometry images, close range, 10 % without a target)",
+        include_str!("../../../presets/realistic-tango.toml"),
     ),
 ];
 
