@@ -154,11 +154,12 @@ pub fn auto_table(scores: &PaperScores) -> String {
     s
 }
 
-/// The three tables (close range) and the far-range summaries, Markdown.
-pub fn report(scores: &PaperScores) -> String {
+/// Tables 6–8 (close range) of `scores` beside the paper's; `world` is added to the
+/// titles (empty: the paper's world).
+fn close_tables(scores: &PaperScores, world: &str) -> String {
     let mut s = String::new();
     s.push_str(&table(
-        "**Table 6** (radiometry, close range 15–50 m, test split; ours, then the paper's)",
+        &format!("**Table 6{world}** (radiometry, close range 15–50 m, test split, frames with a target; ours, then the paper's)"),
         &scores.radiometry,
         &TABLE6,
         "material",
@@ -166,7 +167,9 @@ pub fn report(scores: &PaperScores) -> String {
     ));
     s.push('\n');
     s.push_str(&table(
-        "**Table 7** (detection, close range 15–50 m, test split, by Table 5 scale)",
+        &format!(
+            "**Table 7{world}** (detection, close range 15–50 m, test split, by Table 5 scale)"
+        ),
         &scores.detection,
         &TABLE7,
         "scale",
@@ -174,13 +177,19 @@ pub fn report(scores: &PaperScores) -> String {
     ));
     s.push('\n');
     s.push_str(&table(
-        "**Table 8** (Tango, radiometry, 15–50 m, test split)",
+        &format!("**Table 8{world}** (Tango, radiometry, 15–50 m, test split)"),
         &scores.tango,
         &TABLE8,
         "",
         "close",
     ));
     s.push('\n');
+    s
+}
+
+/// The three tables (close range) and the far-range summaries, Markdown.
+pub fn report(scores: &PaperScores) -> String {
+    let mut s = close_tables(scores, "");
     s.push_str(&far_table(
         "Far range 340–440 m, radiometry, test split: mean IoU (frames)",
         &scores.radiometry,
@@ -252,32 +261,8 @@ pub fn false_alarm_table(title: &str, scores: &PaperScores) -> String {
 /// mid (130–300 m) and far (300–525 m) summaries, the false alarms on frames without a
 /// target, and `auto` against the four.
 pub fn realistic_report(scores: &PaperScores) -> String {
-    let mut s = String::new();
-    s.push_str(&table(
-        "**Table 6, realistic world** (radiometry, close range 15–50 m, test split, frames with a target; the paper's columns are its own world)",
-        &scores.radiometry,
-        &TABLE6,
-        "material",
-        "close",
-    ));
-    s.push('\n');
-    s.push_str(&table(
-        "**Table 7, realistic world** (detection, close range 15–50 m, test split, by Table 5 scale)",
-        &scores.detection,
-        &TABLE7,
-        "scale",
-        "close",
-    ));
-    s.push('\n');
-    s.push_str(&table(
-        "**Table 8, realistic world** (Tango, radiometry, 15–50 m, test split)",
-        &scores.tango,
-        &TABLE8,
-        "",
-        "close",
-    ));
+    let mut s = close_tables(scores, ", realistic world");
     for (band, span) in [("mid", "130–300 m"), ("far", "300–525 m")] {
-        s.push('\n');
         s.push_str(&far_table(
             &format!(
                 "Realistic world, {band} range {span}, radiometry, test split: mean IoU (frames)"
