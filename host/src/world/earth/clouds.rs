@@ -90,6 +90,9 @@ pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 6.0;
 /// Margin of the local clear sky above the Eq. 10 temperature of the interpolated flux,
 /// K: where a cell is warmer than the clear-sky climatology its clear sky warms with it.
 pub const CLEAR_MARGIN_K: f64 = 1.0;
+/// Bisection steps of a cell's threshold shift (2 × 6 σ / 2²⁰ ≈ 10⁻⁵ σ: far below
+/// what moves the cell's flux by 0.01 %; the scale s takes the rest).
+const BISECTION_STEPS: usize = 20;
 /// Coarse node grid per cell axis (1/8° spacing, both borders included).
 const NODES: usize = 9;
 /// Lattice table side (values repeat every 32 lattice cells; each octave is rotated and
@@ -131,6 +134,8 @@ struct Point {
     dt: f64,
     theta: f64,
     n: f64,
+    /// Edge transition width (grows with ΔT), noise units.
+    width: f64,
 }
 
 /// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
@@ -389,11 +394,15 @@ impl CloudField {
                 (t_clear - flux_to_temperature_k(f_top)).clamp(MIN_CLOUD_COLD_K, MAX_CLOUD_COLD_K);
             (dt, self.quantile(1.0 - c))
         };
+        // High (cold, deep) cloud edges are softer than low ones: the width grows with
+        // ΔT (thin cirrus fringes of anvils and fronts).
+        let width = EDGE_WIDTH_SIGMA * self.sigma * (dt / MIN_CLOUD_COLD_K).powf(1.25);
         Point {
             t_clear: t_clear + grain,
             dt,
             theta,
             n,
+            width,
         }
     }
 
@@ -497,7 +506,7 @@ impl CloudField {
             lim
         } else {
             let (mut lo, mut hi) = (-lim, lim);
-            for _ in 0..26 {
+            for _ in 0..BISECTION_STEPS {
                 let mid = 0.5 * (lo + hi);
                 if flux_of(mid) < target {
                     lo = mid;
@@ -572,10 +581,7 @@ impl CloudField {
     #[inline]
     fn temperature(&self, p: &Point, shift: f64) -> f64 {
         let x = p.n - p.theta - shift;
-        // High (cold, deep) cloud edges are softer than low ones: the width grows with
-        // ΔT (thin cirrus fringes of anvils and fronts).
-        let width = EDGE_WIDTH_SIGMA * self.sigma * (p.dt / MIN_CLOUD_COLD_K).powf(1.25);
-        let m = smoothstep(x / width + 0.5);
+        let m = smoothstep(x / p.width + 0.5);
         // Deeper (colder) towards a cloud's core: 0.5 ΔT at the edge, 1.5 ΔT well inside.
         let core = smoothstep(x / (1.2 * self.sigma));
         p.t_clear - (m * p.dt * (0.5 + core)).min(MAX_CLOUD_COLD_K)
