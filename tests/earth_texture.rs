@@ -131,11 +131,13 @@ fn stats_tool_reproduces_the_real_image_readme() {
     assert_eq!(s.bt_k, [259.5, 292.0, 296.0]);
 }
 
-/// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K: the median
-/// over 8 patches (2 days × 4 places, 256 × 256 px) of 2-px step p99 in 9–17 K, share
-/// of steps > 10 K in 0.8–3.5 %, spectral slope in −2.5…−3.3.
+/// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K, over 8 patches
+/// (2 days × 4 places, 256 × 256 px), ranges unchanged: 2-px step p99 in 9–17 K for
+/// every patch; share of steps > 10 K in 0.8–3.5 % for the median and at least 7 of 8
+/// patches (measured 2.1–3.6 %: one convective patch at 3.63 %); spectral slope
+/// (8–200 km) in −2.5…−3.3 for the median and at least 3 of 8 patches (measured: mild
+/// patches −2.25…−2.53, deep-convective −3.31…−3.49).
 #[test]
-#[ignore = "not met yet at 256 px: median share > 10 K is 0.55 % (p99 9.25 K and slope -2.76 pass)"]
 fn texture_statistics_within_the_acceptance_ranges() {
     let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
     let (mut p99, mut share, mut slope) = (Vec::new(), Vec::new(), Vec::new());
@@ -144,21 +146,42 @@ fn texture_statistics_within_the_acceptance_ranges() {
         for &(lat, lon) in &places {
             let t = sample_patch(&f, lat, lon, 256, 256, PATCH_PX_KM, REAL_QUANTUM_K);
             let s = TextureStats::of(&t, 256, 256, PATCH_PX_KM).unwrap();
+            eprintln!(
+                "day {day} ({lat}, {lon}): p99 {} K, share > 10 K {:.2} %, slope {:.2}",
+                s.step2_k[2],
+                100.0 * s.step2_share_over[1],
+                s.spectral_slope
+            );
             p99.push(s.step2_k[2]);
             share.push(s.step2_share_over[1]);
             slope.push(s.spectral_slope);
         }
     }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2])
-    };
-    let (p, s, k) = (median(&mut p99), median(&mut share), median(&mut slope));
+    for p in &p99 {
+        assert!((9.0..=17.0).contains(p), "p99 {p} K");
+    }
+    let shares_in = share
+        .iter()
+        .filter(|s| (0.008..=0.035).contains(*s))
+        .count();
+    share.sort_by(f64::total_cmp);
+    let s_med = 0.5 * (share[share.len() / 2 - 1] + share[share.len() / 2]);
     eprintln!(
-        "median p99 {p} K, share > 10 K {:.2} %, slope {k:.2}",
-        100.0 * s
+        "median share > 10 K {:.2} %, {shares_in} of 8 patches in range",
+        100.0 * s_med
     );
-    assert!((9.0..=17.0).contains(&p), "p99 {p}");
-    assert!((0.008..=0.035).contains(&s), "share {s}");
-    assert!((-3.3..=-2.5).contains(&k), "slope {k}");
+    assert!((0.008..=0.035).contains(&s_med), "median share {s_med}");
+    assert!(
+        shares_in >= 7,
+        "{shares_in} patches with the share in range"
+    );
+    let slopes_in = slope.iter().filter(|k| (-3.3..=-2.5).contains(*k)).count();
+    slope.sort_by(f64::total_cmp);
+    let k = 0.5 * (slope[slope.len() / 2 - 1] + slope[slope.len() / 2]);
+    eprintln!("median slope {k:.2}, {slopes_in} of 8 patches in range");
+    assert!((-3.3..=-2.5).contains(&k), "median slope {k}");
+    assert!(
+        slopes_in >= 3,
+        "{slopes_in} patches with the slope in range"
+    );
 }

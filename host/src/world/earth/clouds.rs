@@ -4,7 +4,7 @@
 //!
 //! At every point the brightness temperature is
 //!
-//! T = s · (T_clear + grain − min(m · ΔT_local, [`MAX_CLOUD_COLD_K`]))
+//! T = s · (T_clear + grain − min(m · ΔT_local, [`MAX_LOCAL_COLD_K`]))
 //!
 //! - T_clear(φ): the Eq. 10 temperature of the clear-sky zonal OLR climatology
 //!   (`CLEAR_SKY_OLR_W_M2`, CERES EBAF), smooth in latitude;
@@ -12,7 +12,7 @@
 //!   between cell centres, so no parameter jumps at cell borders): the share of clear
 //!   flux that is missing, r = 1 − F̃/F_clear, sets the cloud fraction
 //!   c = min(√(r / [`OVERCAST_DEFICIT`]), [`MAX_CLOUD_FRACTION`]) and a mean
-//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 10…80 K colder than
+//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 15.5…40 K colder than
 //!   the clear surface;
 //! - m = a steep smoothstep of (n − θ): n is a fractal field (value noise on the 3-D
 //!   unit sphere × Earth radius, so there is no seam and no pole singularity; octaves
@@ -20,7 +20,7 @@
 //!   ones stretched north–south so that bands run east–west) and θ its (1 − c)
 //!   quantile, so about a share c of the area is cloudy; the transition width
 //!   [`EDGE_WIDTH_SIGMA`] gives 1–3 px cloud edges at 4 km per pixel;
-//! - ΔT_local grows from 0.5 ΔT at a cloud's edge to 1.5 ΔT in its core; the edge
+//! - ΔT_local grows from 0.65 ΔT at a cloud's edge to 1.35 ΔT in its core; the edge
 //!   width grows with ΔT (cold high-cloud fringes are softer than low-cloud edges);
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
@@ -57,22 +57,32 @@ pub const OCTAVE_LATTICE_KM: [f64; 7] = [400.0, 200.0, 100.0, 50.0, 25.0, 12.0, 
 pub const COARSE_OCTAVES: usize = 3;
 /// Amplitude ratio of successive octaves (halving lattices): sets the spectral slope of
 /// the cloud interiors; the sharp edges set the rest.
-pub const OCTAVE_GAIN: f64 = 0.7;
+pub const OCTAVE_GAIN: f64 = 0.65;
 /// North–south compression of the coarse octaves (their features run east–west, as
 /// frontal cloud bands and cirrus streets).
 pub const ZONAL_STRETCH: f64 = 2.0;
 /// Width of the cloud-edge transition in units of the noise's standard deviation.
-pub const EDGE_WIDTH_SIGMA: f64 = 0.08;
+pub const EDGE_WIDTH_SIGMA: f64 = 0.10;
+/// The edge width grows as (ΔT / [`MIN_CLOUD_COLD_K`])^this: deep, cold cloud fringes
+/// (anvil cirrus) are much softer than low-cloud edges, so the 2-px steps stay within
+/// the real scenes' range from trade cumulus to deep convection.
+pub const EDGE_WIDTH_DEPTH_EXPONENT: f64 = 2.5;
+/// Share of a cloud's depth ΔT reached at its edge; the core reaches 2 − this (0.65:
+/// a 15.5 K low cloud steps by ~10 K at its edge, the real mild scene's 2-px p99).
+pub const EDGE_DEPTH_SHARE: f64 = 0.65;
 /// Missing clear-sky flux share r at which a point is overcast: the cloud fraction is
 /// c = √(r / r_overcast), so thin deficits come as many shallow (low) clouds and large
-/// ones as deep, wide decks (r = 0.05: 41 % cloud 10 K colder; r = 0.45: 95 %, 45 K).
+/// ones as deep, wide decks (r = 0.05: 41 % cloud; r = 0.45: 95 %).
 pub const OVERCAST_DEFICIT: f64 = 0.3;
 /// Largest cloud fraction of a point (overcast decks keep some gaps).
 pub const MAX_CLOUD_FRACTION: f64 = 0.95;
 /// Cloud tops are at least this much colder than the clear surface, K.
-pub const MIN_CLOUD_COLD_K: f64 = 10.0;
-/// ... and at most this much, K (also the cap of the texture's local depth).
-pub const MAX_CLOUD_COLD_K: f64 = 80.0;
+pub const MIN_CLOUD_COLD_K: f64 = 15.5;
+/// ... and at most this much, K (deeper flux deficits come as more cloud, not colder).
+pub const MAX_CLOUD_COLD_K: f64 = 40.0;
+/// Cap of the texture's local depth ΔT_local, K (the coldest convective cores: lets the
+/// threshold shift balance the deepest cells without the scale s).
+pub const MAX_LOCAL_COLD_K: f64 = 48.0;
 /// Peak-to-peak amplitude of the clear-sky grain (unresolved trade cumulus, surface
 /// and humidity texture), K.
 pub const CLEAR_GRAIN_K: f64 = 2.0;
@@ -90,6 +100,9 @@ pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 6.0;
 /// Margin of the local clear sky above the Eq. 10 temperature of the interpolated flux,
 /// K: where a cell is warmer than the clear-sky climatology its clear sky warms with it.
 pub const CLEAR_MARGIN_K: f64 = 1.0;
+/// Bisection steps of a cell's threshold shift (2 × 6 σ / 2²⁰ ≈ 10⁻⁵ σ: far below
+/// what moves the cell's flux by 0.01 %; the scale s takes the rest).
+const BISECTION_STEPS: usize = 20;
 /// Coarse node grid per cell axis (1/8° spacing, both borders included).
 const NODES: usize = 9;
 /// Lattice table side (values repeat every 32 lattice cells; each octave is rotated and
@@ -131,6 +144,8 @@ struct Point {
     dt: f64,
     theta: f64,
     n: f64,
+    /// Edge transition width (grows with ΔT), noise units.
+    width: f64,
 }
 
 /// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
@@ -389,11 +404,16 @@ impl CloudField {
                 (t_clear - flux_to_temperature_k(f_top)).clamp(MIN_CLOUD_COLD_K, MAX_CLOUD_COLD_K);
             (dt, self.quantile(1.0 - c))
         };
+        // High (cold, deep) cloud edges are softer than low ones: the width grows with
+        // ΔT (thin cirrus fringes of anvils and fronts).
+        let width =
+            EDGE_WIDTH_SIGMA * self.sigma * (dt / MIN_CLOUD_COLD_K).powf(EDGE_WIDTH_DEPTH_EXPONENT);
         Point {
             t_clear: t_clear + grain,
             dt,
             theta,
             n,
+            width,
         }
     }
 
@@ -497,7 +517,7 @@ impl CloudField {
             lim
         } else {
             let (mut lo, mut hi) = (-lim, lim);
-            for _ in 0..26 {
+            for _ in 0..BISECTION_STEPS {
                 let mid = 0.5 * (lo + hi);
                 if flux_of(mid) < target {
                     lo = mid;
@@ -572,13 +592,11 @@ impl CloudField {
     #[inline]
     fn temperature(&self, p: &Point, shift: f64) -> f64 {
         let x = p.n - p.theta - shift;
-        // High (cold, deep) cloud edges are softer than low ones: the width grows with
-        // ΔT (thin cirrus fringes of anvils and fronts).
-        let width = EDGE_WIDTH_SIGMA * self.sigma * (p.dt / MIN_CLOUD_COLD_K).powf(1.25);
-        let m = smoothstep(x / width + 0.5);
-        // Deeper (colder) towards a cloud's core: 0.5 ΔT at the edge, 1.5 ΔT well inside.
+        let m = smoothstep(x / p.width + 0.5);
+        // Deeper (colder) towards a cloud's core: 0.65 ΔT at the edge, 1.35 ΔT well inside.
         let core = smoothstep(x / (1.2 * self.sigma));
-        p.t_clear - (m * p.dt * (0.5 + core)).min(MAX_CLOUD_COLD_K)
+        let depth = EDGE_DEPTH_SHARE + 2.0 * (1.0 - EDGE_DEPTH_SHARE) * core;
+        p.t_clear - (m * p.dt * depth).min(MAX_LOCAL_COLD_K)
     }
 
     /// The point at fractions (u lat, v lon) of `cell`.
