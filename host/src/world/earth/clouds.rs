@@ -45,6 +45,7 @@ use tirroi_core::sensor::rng::Xoshiro128pp;
 use super::OlrGrid;
 use super::builtin::{CLEAR_SKY_OLR_W_M2, profile};
 use super::flux_to_temperature_k;
+use crate::world::geom::Rotation;
 
 /// Mean Earth radius the noise lives on, km (the lattice sizes are in km on it).
 pub const NOISE_RADIUS_KM: f64 = 6371.0;
@@ -236,23 +237,7 @@ impl CloudField {
                     b * libm::cos(tau * u3),
                 ];
                 let [x, y, z, w] = q;
-                let rot = [
-                    [
-                        1.0 - 2.0 * (y * y + z * z),
-                        2.0 * (x * y - z * w),
-                        2.0 * (x * z + y * w),
-                    ],
-                    [
-                        2.0 * (x * y + z * w),
-                        1.0 - 2.0 * (x * x + z * z),
-                        2.0 * (y * z - x * w),
-                    ],
-                    [
-                        2.0 * (x * z - y * w),
-                        2.0 * (y * z + x * w),
-                        1.0 - 2.0 * (x * x + y * y),
-                    ],
-                ];
+                let rot = Rotation::from_quaternion([w, x, y, z]).0;
                 let offset = [unif() * 1e3, unif() * 1e3, unif() * 1e3];
                 let o = Octave {
                     rot,
