@@ -33,7 +33,6 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Poisson, StandardNormal};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
-use tirroi_core::sensor::DnMapping;
 
 use crate::imaging::render::FixedGain;
 
@@ -171,22 +170,12 @@ impl Calibration {
     /// a = g/π (g = [`GainCalibration::dn_per_w_m2_sr`], the real camera's DN per band
     /// radiance, taken as the 14-bit DN) and b = [`FIXED_GAIN_PEDESTAL_DN`], both scaled
     /// by 2^(bits − 14) when a frame's map is made
-    /// ([`DnMapping::radiometry_fixed_gain`]).
+    /// ([`tirroi_core::sensor::DnMapping::radiometry_fixed_gain`]).
     pub fn fixed_gain(&self) -> FixedGain {
         FixedGain {
             dn_per_w_m2_sr: self.gain.dn_per_w_m2_sr,
             pedestal_dn: FIXED_GAIN_PEDESTAL_DN,
         }
-    }
-
-    /// [`Calibration::fixed_gain`] as the DN map of a frame of `bits` bits.
-    ///
-    /// # Errors
-    /// A message for a bit depth outside 1..=16.
-    pub fn fixed_gain_mapping(&self, bits: u8) -> Result<DnMapping, String> {
-        let g = self.fixed_gain();
-        DnMapping::radiometry_fixed_gain(g.dn_per_w_m2_sr, g.pedestal_dn, bits)
-            .map_err(|e| format!("fixed-gain readout: {e}"))
     }
 
     /// Fixed per-pixel residual σ, DN: the fitted σ less the temporal noise in
