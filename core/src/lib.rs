@@ -102,4 +102,4 @@ pub mod sensor;
 
 pub use capacity::{Capacity, FrameCapacity, Reference};
 pub use frame::{Frame, FrameError};
-pub use roi::{BoxRule, DetectError, Detection, Detector, Method, Roi};
+pub use roi::{BoxRule, DetectError, Detection, Detector, Method, Roi, SCORE_FULL_PERMILLE};

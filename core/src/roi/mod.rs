@@ -87,6 +87,31 @@ pub struct Detection {
     pub threshold: u32,
     /// Number of foreground pixels in the mask (before the [`BoxRule`]).
     pub foreground_px: u32,
+    /// Confidence that `roi` is the target (a hit: IoU ≥ 0.5 with the truth), in
+    /// thousandths: 0–[`SCORE_FULL_PERMILLE`]. `0` whenever `roi` is `None`. The paper's
+    /// four detectors have no model of confidence: they report
+    /// [`SCORE_FULL_PERMILLE`] for any box. Integer, so the host and flight builds agree
+    /// bit for bit.
+    pub score_permille: u16,
+}
+
+/// The largest [`Detection::score_permille`]: full confidence (1.000).
+pub const SCORE_FULL_PERMILLE: u16 = 1000;
+
+impl Detection {
+    /// The confidence as a fraction in 0–1 (`score_permille / 1000`).
+    pub fn score(&self) -> f32 {
+        f32::from(self.score_permille) / f32::from(SCORE_FULL_PERMILLE)
+    }
+
+    /// The score the paper's four report: full confidence for a box, zero without.
+    pub const fn certain_if_found(roi: &Option<Roi>) -> u16 {
+        if roi.is_some() {
+            SCORE_FULL_PERMILLE
+        } else {
+            0
+        }
+    }
 }
 
 /// Why a detector refused to run.
@@ -247,6 +272,7 @@ pub trait Detector: Sized {
         let threshold = self.foreground(frame, work, |y, mask| roi.push_row(y, mask));
         let (found, foreground_px) = roi.finish();
         Ok(Detection {
+            score_permille: Detection::certain_if_found(&found),
             roi: found,
             threshold,
             foreground_px,

@@ -396,6 +396,7 @@ impl Detector for Wge {
         let passes = self.passes(frame, work, all);
         if let Some((found, foreground_px)) = passes.hull {
             return Ok(Detection {
+                score_permille: Detection::certain_if_found(&found),
                 roi: found,
                 threshold: passes.threshold,
                 foreground_px,
@@ -405,6 +406,7 @@ impl Detector for Wge {
         Self::mask_pass(frame, work, passes.threshold, |y, m| roi.push_row(y, m));
         let (found, foreground_px) = roi.finish();
         Ok(Detection {
+            score_permille: Detection::certain_if_found(&found),
             roi: found,
             threshold: passes.threshold,
             foreground_px,

@@ -33,13 +33,15 @@ pub struct DetectArgs {
 }
 
 /// The JSON line of `tirroi detect --json`: `{"file","method","bbox":[x0,y0,x1,y1] or
-/// null,"time_us"}`, `time_us` the median over `--repeat` runs of the core call alone
+/// null,"score","time_us"}`, `score` the detector's confidence in 0–1 (0 for `null`;
+/// see `Detection::score_permille`), `time_us` the median over `--repeat` runs of the core call alone
 /// (the conventions in `docs/architecture.md`).
 #[derive(Debug, Serialize)]
 struct DetectLine<'a> {
     file: &'a str,
     method: &'static str,
     bbox: Option<[u16; 4]>,
+    score: f32,
     time_us: f64,
 }
 
@@ -87,6 +89,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     file: &file,
                     method: method.name(),
                     bbox: d.roi.map(|r| r.to_array()),
+                    score: d.score(),
                     time_us: (time_us * 1000.0).round() / 1000.0,
                 };
                 serde_json::to_string(&line)
@@ -99,8 +102,9 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     .unwrap_or_else(|| "none".into());
                 writeln!(
                     out,
-                    "{file}  {:<8}  bbox {bbox:<22}  {time_us:>9.1} us  threshold {}  foreground {} px",
+                    "{file}  {:<8}  bbox {bbox:<22}  score {:.3}  {time_us:>9.1} us  threshold {}  foreground {} px",
                     method.name(),
+                    d.score(),
                     d.threshold,
                     d.foreground_px
                 )

@@ -57,6 +57,7 @@ impl Auto {
                 roi: None,
                 threshold: 0,
                 foreground_px: 0,
+                score_permille: 0,
             },
         }
     }
@@ -67,5 +68,6 @@ fn detection(f: Found) -> Detection {
         roi: f.roi,
         threshold: f.threshold,
         foreground_px: f.edge_px,
+        score_permille: Detection::certain_if_found(&f.roi),
     }
 }
