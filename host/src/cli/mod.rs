@@ -13,6 +13,7 @@
 //! | `eval` | [`eval`] |
 //! | `paper` (the default) | [`paper`] |
 //! | `render` | [`render`] |
+//! | `merge` | [`merge`] |
 //! | `tune` | [`tune`] |
 //!
 //! `--method` of `detect`, `eval` and `tune` is parsed in one place, [`methods`].
@@ -28,6 +29,7 @@ pub mod earth_texture;
 pub mod eval;
 pub mod fixtures;
 pub mod memory;
+pub mod merge;
 pub mod methods;
 pub mod paper;
 pub mod render;
@@ -113,6 +115,10 @@ pub enum Command {
     /// Presets: paper (12 000 images, Section 4.1), tango (1 000, Section 5), quick (24).
     /// The same seed gives the same bytes; a stopped run can continue with --resume.
     Render(render::RenderArgs),
+    /// Join the parts of a dataset rendered with `render --shard I/N` (on several
+    /// machines or job-array tasks) into one directory: the same bytes as rendering it
+    /// on one machine.
+    Merge(merge::MergeArgs),
     /// Tune each detector's parameters on labelled frames: a fixed grid, then
     /// coordinate refinement, scored by mean IoU on the tune part (about 30 % of the
     /// frames, by a hash of the file name), then checked on the test part. Markdown on
@@ -143,6 +149,7 @@ pub fn main() -> ExitCode {
         Command::Paper(args) => exit_code(paper::run(&args)),
         Command::Tune(args) => exit_code(tune::run(&args)),
         Command::Render(args) => exit_code(render::run(&args)),
+        Command::Merge(args) => exit_code(merge::run(&args)),
         Command::EarthTexture(args) => exit_code(earth_texture::run(&args)),
     }
 }

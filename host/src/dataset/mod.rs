@@ -39,10 +39,17 @@ use crate::world::scene::SceneFile;
 mod images;
 mod labels;
 mod library;
+mod manifest;
+mod merge;
 mod plan;
 
 pub use images::ImageRecord;
 pub use library::{Library, ThermalState};
+pub use manifest::{
+    JOURNAL_FILE, LABEL_FILES, MANIFEST_FILE, MAX_SHARDS, Manifest, OutState, Outputs, RunSource,
+    Shard, clear_run, inspect, quote, sha256_hex,
+};
+pub use merge::merge;
 pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
 use images::write_image;
@@ -71,6 +78,9 @@ pub struct WriteOptions {
     pub resume: bool,
     /// Show a progress bar.
     pub progress: bool,
+    /// Render only this part of the dataset (`None`: all of it); the label files then
+    /// list its images only, and `tirroi merge` joins the parts.
+    pub shard: Option<Shard>,
 }
 
 /// Totals of a dataset run.
@@ -116,7 +126,7 @@ pub fn write_dataset(
         }
     }
     let plans = plan(file);
-    let journal_path = dir.join("progress.jsonl");
+    let journal_path = dir.join(JOURNAL_FILE);
     let mut done: BTreeMap<usize, ImageRecord> = BTreeMap::new();
     if options.resume && journal_path.exists() {
         let f = File::open(&journal_path).map_err(|e| io(&journal_path, e))?;
@@ -128,10 +138,15 @@ pub fn write_dataset(
             }
         }
     }
+    let mine = |i: usize| options.shard.is_none_or(|s| s.contains(i));
+    done.retain(|&i, _| mine(i));
     let todo: Vec<&ImagePlan> = plans
         .iter()
-        .filter(|p| !done.contains_key(&p.index))
+        .filter(|p| mine(p.index) && !done.contains_key(&p.index))
         .collect();
+    // The whole dataset's library even for a shard: its pieces (the first day's mean
+    // Earth flux, the Earth distance, transient orbits) depend on every plan, and a
+    // shard's frames must be the single run's bytes.
     let library = Library::build(file, &plans)?;
     let t1 = Instant::now();
 
@@ -152,12 +167,16 @@ pub fn write_dataset(
             let start = Instant::now();
             let (frame, thermal) = library.render(file, plan)?;
             let (rec, write_s) = write_image(dir, file, plan, &frame, &thermal, options)?;
-            let line = serde_json::to_string(&rec).map_err(|e| DatasetError(e.to_string()))?;
+            let mut line = serde_json::to_string(&rec).map_err(|e| DatasetError(e.to_string()))?;
+            line.push('\n');
             {
                 let mut j = journal
                     .lock()
                     .map_err(|_| DatasetError("journal lock".into()))?;
-                writeln!(j, "{line}").map_err(|e| io(&journal_path, e))?;
+                // One write per line: a stop leaves at most one torn line, skipped on
+                // resume.
+                j.write_all(line.as_bytes())
+                    .map_err(|e| io(&journal_path, e))?;
             }
             bar.inc(1);
             Ok((rec, frame.stats, write_s, start.elapsed().as_secs_f64()))

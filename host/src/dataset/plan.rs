@@ -251,7 +251,10 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
             TargetModel::Tango => vec![MaterialCase::Mono],
         };
         let lights = spec.illumination.values();
-        let poses = spec.count / scales.len();
+        // Whole poses, and a last partial one (its first `count mod scales` scales)
+        // when the count is not a multiple of the scales.
+        let poses = spec.count.div_ceil(scales.len());
+        let kind_start = plans.len();
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
         let focal_px = file.camera.focal_px();
@@ -367,6 +370,9 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 orbit_time_bits: orbit_time_s.map(f64::to_bits),
             };
             for (k, &scale) in scales.iter().enumerate() {
+                if plans.len() - kind_start == spec.count {
+                    break;
+                }
                 let index = plans.len();
                 plans.push(ImagePlan {
                     index,

@@ -96,7 +96,11 @@ pub struct PaperScores {
     pub tango: Vec<FrameScore>,
 }
 
-/// Renders `preset` into `dir` unless a complete dataset of the same size is there.
+/// Renders `preset` into `dir` unless the complete run of the same resolved
+/// configuration and tirroi version is there (its `tirroi-run.json` says so); an
+/// unfinished run of it is resumed, anything else of tirroi's in `dir` (another
+/// configuration or version, or a directory from before manifests) is replaced. Files
+/// that are not tirroi's are left alone.
 fn dataset(
     preset: &str,
     count: Option<usize>,
@@ -110,26 +114,62 @@ fn dataset(
     if let Some(n) = count {
         file.rescale_count(n).map_err(|e| e.to_string())?;
     }
+    let outputs = dataset::Outputs {
+        masks: false,
+        preview: false,
+    };
+    let manifest = dataset::Manifest::new(
+        dataset::RunSource::Preset(preset.into()),
+        &file,
+        outputs,
+        None,
+    )
+    .map_err(|e| e.to_string())?;
     let truth = dir.join("truth.csv");
-    let reuse = scoring::read_truth(&truth)
-        .map(|rows| rows.len() == file.image_count())
-        .unwrap_or(false);
-    if reuse {
-        eprintln!("reusing {} ({} images)", dir.display(), file.image_count());
-    } else {
-        eprintln!(
-            "rendering {} images of `{preset}` into {}",
-            file.image_count(),
-            dir.display()
-        );
-        let options = WriteOptions {
-            masks: false,
-            preview: false,
-            resume: true,
-            progress,
-        };
-        dataset::write_dataset(&file, dir, &options).map_err(|e| e.to_string())?;
+    let old = dataset::Manifest::read(dir).map_err(|e| e.to_string())?;
+    let same = old.as_ref().filter(|m| m.differences(&manifest).is_empty());
+    if same.is_some_and(|m| m.complete) {
+        eprintln!("reusing {} ({})", dir.display(), manifest.summary());
+        return scoring::read_truth(&truth).map_err(|e| e.to_string());
     }
+    let resume = same.is_some();
+    if !resume && dir.exists() {
+        match &old {
+            Some(m) => eprintln!(
+                "replacing {} ({}): {}",
+                dir.display(),
+                m.summary(),
+                m.differences(&manifest).join("; ")
+            ),
+            None => eprintln!(
+                "replacing the frames in {} (no {}: rendered before run manifests)",
+                dir.display(),
+                dataset::MANIFEST_FILE
+            ),
+        }
+        dataset::clear_run(dir).map_err(|e| e.to_string())?;
+    }
+    eprintln!(
+        "rendering {} images of `{preset}` into {}",
+        file.image_count(),
+        dir.display()
+    );
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    manifest.write(dir).map_err(|e| e.to_string())?;
+    let options = WriteOptions {
+        masks: false,
+        preview: false,
+        resume,
+        progress,
+        shard: None,
+    };
+    dataset::write_dataset(&file, dir, &options).map_err(|e| e.to_string())?;
+    dataset::Manifest {
+        complete: true,
+        ..manifest
+    }
+    .write(dir)
+    .map_err(|e| e.to_string())?;
     scoring::read_truth(&truth).map_err(|e| e.to_string())
 }
 

@@ -191,9 +191,13 @@ impl SceneFile {
         SceneFile::parse(text, &format!("preset:{name}"))
     }
 
-    /// Spreads `total` images over the scene kinds in proportion to their counts, each
-    /// rounded to whole poses (detection: multiples of its scales) and at least one
-    /// pose; the result can differ from `total` by the rounding.
+    /// Spreads exactly `total` images over the scene kinds in proportion to their
+    /// counts: each kind gets the floor of its share, and the images left over go one
+    /// each to the kinds with the largest remainders (ties: the earlier kind) — the
+    /// largest-remainder (Hamilton) apportionment, so no kind is off its share by a
+    /// whole image. A kind may get 0 images (when `total` is below the number of
+    /// kinds), and a detection kind may end on a partial pose ([`SceneSpec::count`]).
+    /// A file whose counts already are `total` in proportion keeps them unchanged.
     ///
     /// # Errors
     /// [`SceneError`] for a total of 0.
@@ -205,15 +209,9 @@ impl SceneFile {
                 message: "0 images: expected at least 1".into(),
             });
         }
-        let old = self.image_count().max(1) as f64;
-        for s in &mut self.scenes {
-            let per_pose = match s.mode {
-                Mode::Radiometry => 1,
-                Mode::Detection => s.scale.values().len().max(1),
-            };
-            let share = total as f64 * s.count as f64 / old;
-            let poses = ((share / per_pose as f64).round() as usize).max(1);
-            s.count = poses * per_pose;
+        let counts: Vec<usize> = self.scenes.iter().map(|s| s.count).collect();
+        for (s, n) in self.scenes.iter_mut().zip(apportion(total, &counts)) {
+            s.count = n;
         }
         Ok(())
     }
@@ -244,6 +242,9 @@ impl SceneFile {
         for (i, s) in self.scenes.iter().enumerate() {
             s.validate(&format!("scene[{i}]"), self.earth_model.radius_km)?;
         }
+        if self.image_count() == 0 {
+            return Err("every [[scene]] has count = 0: expected at least 1 image in total".into());
+        }
         if self.image_count() > 10_000_000 {
             return Err(format!(
                 "{} images in total: expected at most 10 000 000",
@@ -252,6 +253,30 @@ impl SceneFile {
         }
         Ok(())
     }
+}
+
+/// `total` split in proportion to `weights` by the largest-remainder method: the
+/// parts sum to `total` exactly (all weights 0: equal weights).
+pub fn apportion(total: usize, weights: &[usize]) -> Vec<usize> {
+    let all_zero = weights.iter().all(|&w| w == 0);
+    let w: Vec<u128> = weights
+        .iter()
+        .map(|&w| if all_zero { 1 } else { w as u128 })
+        .collect();
+    let sum: u128 = w.iter().sum::<u128>().max(1);
+    // Integer arithmetic: share_i = total·w_i / sum, exact floor and remainder.
+    let mut parts: Vec<usize> = w
+        .iter()
+        .map(|&wi| (total as u128 * wi / sum) as usize)
+        .collect();
+    let rem: Vec<u128> = w.iter().map(|&wi| total as u128 * wi % sum).collect();
+    let left = total - parts.iter().sum::<usize>();
+    let mut order: Vec<usize> = (0..w.len()).collect();
+    order.sort_by(|&a, &b| rem[b].cmp(&rem[a]).then(a.cmp(&b)));
+    for &i in order.iter().take(left) {
+        parts[i] += 1;
+    }
+    parts
 }
 
 /// The key of the `key = value` line holding byte `offset`, if any.

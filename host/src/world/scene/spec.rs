@@ -166,7 +166,10 @@ pub struct SceneSpec {
     /// Label of this kind (default "scene-N").
     #[serde(default)]
     pub name: Option<String>,
-    /// Images of this kind (detection: a multiple of the number of scales).
+    /// Images of this kind (0 turns the kind off; the file's total must be at least 1).
+    /// Detection renders each pose at every scale, in order; when `count` is not a
+    /// multiple of the scales, the last pose is rendered at the first `count mod
+    /// scales` of them only (so `--count N` gives exactly N images).
     #[serde(default = "one")]
     pub count: usize,
     /// Camera mode.
@@ -340,9 +343,6 @@ impl SceneSpec {
     }
 
     pub(super) fn validate(&self, at: &str, earth_radius_km: f64) -> Result<(), String> {
-        if self.count == 0 {
-            return Err(format!("{at}.count = 0: expected at least 1 image"));
-        }
         if self.count > 1_000_000 {
             return Err(format!(
                 "{at}.count = {}: expected at most 1 000 000",
@@ -353,13 +353,6 @@ impl SceneSpec {
         if scales.is_empty() || scales.iter().any(|s| !(1..=3).contains(s)) {
             return Err(format!(
                 "{at}.scale = {scales:?}: expected 1, 2 or 3 (Table 5), or a non-empty list of them"
-            ));
-        }
-        if self.mode == Mode::Detection && self.count % scales.len() != 0 {
-            return Err(format!(
-                "{at}.count = {}: expected a multiple of the {} scales (each pose is rendered at every scale)",
-                self.count,
-                scales.len()
             ));
         }
         if self.material.values().is_empty() {
