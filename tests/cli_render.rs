@@ -98,8 +98,10 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     for (name, bytes) in &fa {
         assert!(bytes == &fb[name], "{name} differs between 1 and 2 threads");
     }
-    // 6 PNG + 6 masks + 6 previews + truth.csv + coco.json + metadata.jsonl, nothing else.
-    assert_eq!(fa.len(), 21, "{:?}", fa.keys().collect::<Vec<_>>());
+    // 6 PNG + 6 masks + 6 previews + truth.csv + coco.json + metadata.jsonl + the run
+    // manifest tirroi-run.json, nothing else.
+    assert_eq!(fa.len(), 22, "{:?}", fa.keys().collect::<Vec<_>>());
+    assert!(fa.contains_key("/tirroi-run.json"));
     assert!(
         !fa.keys()
             .any(|k| k.ends_with(".part") || k.contains("progress"))
@@ -178,9 +180,17 @@ fn a_stopped_run_resumes_to_the_same_bytes() {
     fs::write(&config, SMALL).unwrap();
     let full = tmp.path().join("full");
     render_into(&config, &full, "2", &[]);
-    // Simulate a stop after 4 images: the journal lists them, no label files yet.
+    // Simulate a stop after 4 images: the manifest of an unfinished run, the journal
+    // lists them, no label files yet.
     let part = tmp.path().join("part");
     fs::create_dir(&part).unwrap();
+    let manifest = fs::read_to_string(full.join("tirroi-run.json")).unwrap();
+    assert!(manifest.contains("\"complete\": true"), "{manifest}");
+    fs::write(
+        part.join("tirroi-run.json"),
+        manifest.replace("\"complete\": true", "\"complete\": false"),
+    )
+    .unwrap();
     let meta = fs::read_to_string(full.join("metadata.jsonl")).unwrap();
     let journal: String = meta.lines().take(4).map(|l| format!("{l}\n")).collect();
     fs::write(part.join("progress.jsonl"), journal).unwrap();
