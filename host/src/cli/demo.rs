@@ -17,11 +17,13 @@ pub fn run(repeat: usize, figures: Option<&Path>) -> ExitCode {
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     }
+    let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
     println!(
-        "tirroi demo: the paper's four detectors and `auto` on procedural 328x248 14-bit frames"
+        "tirroi demo: every detector ({}) on procedural 328x248 14-bit frames",
+        names.join(", ")
     );
     println!(
-        "(not physically rendered: the renderer and the paper's tables come with later work)\n"
+        "(procedural test input, not physically rendered: `tirroi render` makes rendered frames)\n"
     );
     let mut bank = DetectorBank::default();
     println!(

@@ -7,23 +7,23 @@ use std::process::ExitCode;
 use serde::Serialize;
 
 use super::EXIT_BAD_INPUT;
-use super::methods::{MethodChoice, parse_methods};
+use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
 use crate::imaging::image_io::read_frame;
 
 /// The options of `tirroi detect`.
 #[derive(Debug, clap::Args)]
 pub struct DetectArgs {
-    /// Detector: otsu, adaptive, wge, dog, auto, or all (the five).
-    #[arg(long, default_value = "all", value_parser = parse_methods)]
+    /// The detectors (help generated from the core registry by `method_help`).
+    #[arg(long, default_value = "all", value_parser = parse_methods, help = method_help("Detector"))]
     pub method: MethodChoice,
-    /// Runs per frame and method; the reported time is the median.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    /// Runs per frame and method (the one range of `REPEAT_RANGE`); the median time is reported.
+    #[arg(long, default_value_t = 1, value_parser = super::repeat_parser(), help = super::repeat_help())]
     pub repeat: u32,
     /// Print one JSON object per frame and method.
     #[arg(long)]
     pub json: bool,
-    /// Bit depth of the DN (default: 8 for 8-bit files; 14 for 16-bit files whose
+    /// Bit depth of the DN, 1..=16 (default: 8 for 8-bit files; 14 for 16-bit files whose
     /// DN fit, else 16).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use tirroi_core::BoxRule;
 
-use super::methods::{MethodChoice, parse_methods};
+use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
 use crate::eval::scoring;
 use crate::progress;
@@ -18,16 +18,16 @@ pub struct EvalArgs {
     /// Labels (default: IMAGES/truth.csv), header `file,x0,y0,x1,y1[,extra...]`.
     #[arg(long)]
     pub truth: Option<PathBuf>,
-    /// Detector: otsu, adaptive, wge, dog, auto, or all (the five).
-    #[arg(long, default_value = "all", value_parser = parse_methods)]
+    /// The detectors (help generated from the core registry by `method_help`).
+    #[arg(long, default_value = "all", value_parser = parse_methods, help = method_help("Detector"))]
     pub method: MethodChoice,
-    /// Runs per frame and method; the reported time is the median.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    /// Runs per frame and method (the one range of `REPEAT_RANGE`); the median time is reported.
+    #[arg(long, default_value_t = 3, value_parser = super::repeat_parser(), help = super::repeat_help())]
     pub repeat: u32,
     /// Mask-to-box rule: largest-component or all-foreground.
     #[arg(long, default_value = "largest-component", value_parser = parse_box_rule)]
     pub box_rule: BoxRule,
-    /// Bit depth of the DN (default: 14 for 16-bit files whose DN fit).
+    /// Bit depth of the DN, 1..=16 (default: 14 for 16-bit files whose DN fit).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
     /// Write scores.csv, summary.csv and summary.json here.

@@ -2,6 +2,17 @@
 
 use tirroi_core::Method;
 
+/// The help of a `--method` option: `what`, then every method of the core registry
+/// (`Method::ALL`, so a new detector appears without editing any help text) and `all`.
+pub fn method_help(what: &str) -> String {
+    let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+    format!(
+        "{what}: {}, or all (the {} in this order)",
+        names.join(", "),
+        names.len()
+    )
+}
+
 /// One method or all of them.
 #[derive(Debug, Clone)]
 pub struct MethodChoice(pub Vec<Method>);

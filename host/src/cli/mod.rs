@@ -40,6 +40,25 @@ pub mod tune;
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
 
+/// The one range of `--repeat` (runs per frame and method, the time reported is their
+/// median) in every subcommand that times detectors: at least 1, at most 1000 (a
+/// 1000-run median is far below the wall-clock drift of a shared machine).
+pub const REPEAT_RANGE: std::ops::RangeInclusive<i64> = 1..=1000;
+
+/// The parser of every `--repeat`: an integer in [`REPEAT_RANGE`].
+pub fn repeat_parser() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(REPEAT_RANGE)
+}
+
+/// The help of every `--repeat`, with its range.
+pub fn repeat_help() -> String {
+    format!(
+        "Runs per frame and method, {}..={}; the reported time is the median",
+        REPEAT_RANGE.start(),
+        REPEAT_RANGE.end()
+    )
+}
+
 /// tirroi: synthetic thermal-infrared frames and flight-ready ROI detection.
 #[derive(Debug, Parser)]
 #[command(
@@ -57,8 +76,17 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Detect the ROI in 8/16-bit grayscale PNG (or TIFF) frames.
+    ///
+    /// One line per frame and method: the box [x0, y0, x1, y1] (x1, y1 exclusive; none
+    /// when no pixel is foreground), the score (confidence 0-1 that the box is the
+    /// target; the paper's four report 1 for any box), the median core time, then
+    /// threshold: the value the detector cut its response at to make the foreground
+    /// mask (in the detector's own unit, e.g. DN for otsu; docs/detectors.md), and
+    /// foreground: the pixels in that mask (before the box rule draws the box from
+    /// it). --json prints {"file","method","bbox","score","time_us"}.
     Detect(detect::DetectArgs),
-    /// Print the scratch memory of each detector, in bytes.
+    /// Print the scratch memory of each detector, in bytes (the README's memory table
+    /// is this output).
     Memory,
     /// Write the procedural fixture frames as 16-bit PNG with a `truth.csv`.
     Fixtures {
@@ -68,8 +96,8 @@ pub enum Command {
     },
     /// Run every detector on the built-in procedural frames and print IoU and time.
     Demo {
-        /// Runs per frame and method; the reported time is the median.
-        #[arg(long, default_value_t = 21)]
+        /// Runs per frame and method (the one range of `REPEAT_RANGE`); the median time is reported.
+        #[arg(long, default_value_t = 21, value_parser = repeat_parser(), help = repeat_help())]
         repeat: u32,
         /// Also write each frame with the detectors' boxes (largest-component rule) as
         /// PNG into this directory.
@@ -112,8 +140,12 @@ pub enum Command {
     /// Render a labelled synthetic dataset: 16-bit PNG of DN, truth.csv, coco.json and
     /// metadata.jsonl (optionally masks/ and preview/), from a preset or a TOML file.
     ///
-    /// Presets: paper (12 000 images, Section 4.1), tango (1 000, Section 5), quick (24).
-    /// The same seed gives the same bytes; a stopped run can continue with --resume.
+    /// Presets (`--list-presets`): paper (12 000 images, Section 4.1), tango (1 000,
+    /// Section 5), quick (24), realistic (12 000), realistic-tango (1 000). The same
+    /// seed gives the same bytes. A manifest (tirroi-run.json) records the run: a
+    /// non-empty directory that is not a tirroi run is never written to, a previous
+    /// run is replaced only with --force, and --resume continues a stopped one (Ctrl-C
+    /// prints the command). --shard I/N and `tirroi merge` split a run over machines.
     Render(render::RenderArgs),
     /// Join the parts of a dataset rendered with `render --shard I/N` (on several
     /// machines or job-array tasks) into one directory: the same bytes as rendering it

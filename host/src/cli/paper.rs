@@ -16,8 +16,8 @@ pub struct PaperArgs {
     /// Full-size datasets: 12 000 + 1 000 images.
     #[arg(long)]
     pub full: bool,
-    /// Runs per frame and method for the timing (median).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    /// Runs per frame and method (the one range of `REPEAT_RANGE`); the median time is reported.
+    #[arg(long, default_value_t = 3, value_parser = super::repeat_parser(), help = super::repeat_help())]
     pub repeat: u32,
 }
 

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use tirroi_core::BoxRule;
 
-use super::methods::{MethodChoice, parse_methods};
+use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::scoring;
 use crate::eval::split::{Split, TUNE_PERCENT, Where, filter, parse_where, split};
 use crate::eval::tune::{SearchOptions, defaults, evaluate, grid, search, trials_csv};
@@ -20,21 +20,21 @@ pub struct TuneArgs {
     /// Labels (default: IMAGES/truth.csv), header `file,x0,y0,x1,y1[,extra...]`.
     #[arg(long)]
     pub truth: Option<PathBuf>,
-    /// Detector to tune: otsu, adaptive, wge, dog, auto, or all (the five).
-    #[arg(long, default_value = "all", value_parser = parse_methods)]
+    /// The detectors (help generated from the core registry by `method_help`).
+    #[arg(long, default_value = "all", value_parser = parse_methods, help = method_help("Detector to tune"))]
     pub method: MethodChoice,
     /// Keep only frames with this group label, `key=value`; key: mode, scale, target,
     /// material, illumination or range (close <= 50 m, far >= 300 m, else mid).
     /// Repeat it: different keys must all match, values of one key are alternatives.
     #[arg(long = "where", value_name = "KEY=VALUE", value_parser = parse_where)]
     pub wheres: Vec<Where>,
-    /// Bit depth of the DN (default: 14 for 16-bit files whose DN fit).
+    /// Bit depth of the DN, 1..=16 (default: 14 for 16-bit files whose DN fit).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
-    /// Most refinement moves per method after the grid (0: grid only).
+    /// Most refinement moves per method after the grid, 0..=100 (0: grid only).
     #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(0..=100))]
     pub refine_steps: u32,
-    /// Grid sets refined per method (the best by mean IoU).
+    /// Grid sets refined per method (the best by mean IoU), 1..=20.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
     pub starts: u32,
     /// Write trials.csv (method,params,mean_iou,median_iou,mean_time_ms) here.
