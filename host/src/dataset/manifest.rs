@@ -31,6 +31,10 @@ pub const MANIFEST_FORMAT: u32 = 1;
 /// The label files a run writes beside its images.
 pub const LABEL_FILES: [&str; 3] = ["truth.csv", "coco.json", "metadata.jsonl"];
 
+/// The files every run writes: 16-bit PNG frames of DN and the label files (the
+/// manifest's `formats`; `outputs` adds masks and previews).
+pub const FORMATS: [&str; 4] = ["png-16bit-dn", "truth.csv", "coco.json", "metadata.jsonl"];
+
 /// The journal of finished images of an unfinished run.
 pub const JOURNAL_FILE: &str = "progress.jsonl";
 
@@ -119,6 +123,8 @@ pub struct Manifest {
     pub seed: u64,
     /// Images of the whole dataset (after `--count`; all shards together).
     pub count: usize,
+    /// The files every image and the run get ([`FORMATS`]).
+    pub formats: Vec<String>,
     /// Optional outputs.
     pub outputs: Outputs,
     /// The part of the dataset this directory holds (`None`: all of it).
@@ -144,6 +150,7 @@ impl Manifest {
             name: file.dataset.name.clone(),
             seed: file.dataset.seed,
             count: file.image_count(),
+            formats: FORMATS.iter().map(|f| f.to_string()).collect(),
             outputs,
             shard,
             scene: toml::to_string(file).map_err(|e| DatasetError(e.to_string()))?,
@@ -176,6 +183,13 @@ impl Manifest {
         }
         if self.count != other.count {
             d.push(format!("its count is {}, not {}", self.count, other.count));
+        }
+        if self.formats != other.formats {
+            d.push(format!(
+                "its files are {}, not {}",
+                self.formats.join(", "),
+                other.formats.join(", ")
+            ));
         }
         let on = |b: bool| if b { "on" } else { "off" };
         if self.outputs.masks != other.outputs.masks {
