@@ -12,6 +12,9 @@
 //! `scoring` ← `split` ← `tune`; `tuned` needs only `bank`.
 
 pub mod bank;
+pub mod confidence;
+pub mod confidence_report;
+pub mod predictions;
 pub mod scoring;
 pub mod split;
 pub mod tune;
