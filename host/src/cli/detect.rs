@@ -27,6 +27,10 @@ pub struct DetectArgs {
     /// DN fit, else 16).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
+    /// Mask-to-box rule for every detector: largest-component or all-foreground
+    /// (default: each detector's own; `eval` uses largest-component unless told).
+    #[arg(long, value_parser = super::eval::parse_box_rule)]
+    pub box_rule: Option<tirroi_core::BoxRule>,
     /// FITS frames: DN added to each value before rounding and clamping to the bit
     /// depth (default: 1024 for float data, 0 for integer data; docs/cli.md § FITS).
     #[arg(long, value_name = "DN", allow_negative_numbers = true)]
@@ -64,6 +68,9 @@ pub fn run(args: &DetectArgs) -> ExitCode {
         &args.files,
     );
     let mut bank = DetectorBank::default();
+    if let Some(rule) = args.box_rule {
+        bank.set_box_rule(rule);
+    }
     let mut failed = false;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();

@@ -6,9 +6,9 @@ use tirroi_core::BoxRule;
 
 use super::methods::{MethodChoice, parse_methods};
 use crate::eval::bank::DetectorBank;
+use crate::eval::confidence_report;
 use crate::eval::predictions::{self, PredictionSet};
 use crate::eval::scoring::{self, EvalError, TruthCoverage, TruthRow};
-use crate::eval::confidence_report;
 use crate::imaging::image_io;
 use crate::progress;
 
@@ -83,7 +83,11 @@ fn parse_eval_methods(s: &str) -> Result<MethodChoice, String> {
     }
 }
 
-fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
+/// Parses a `--box-rule` value (`eval`, `detect`).
+///
+/// # Errors
+/// One line naming the two rules.
+pub fn parse_box_rule(s: &str) -> Result<BoxRule, String> {
     BoxRule::from_name(s).ok_or_else(|| {
         format!("unknown box rule `{s}`; expected largest-component or all-foreground")
     })
@@ -122,7 +126,8 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         .truth
         .clone()
         .unwrap_or_else(|| images.join("truth.csv"));
-    let lines = scoring::read_truth_lines(&truth, args.truth_coverage).map_err(|e| e.to_string())?;
+    let lines =
+        scoring::read_truth_lines(&truth, args.truth_coverage).map_err(|e| e.to_string())?;
     // The other truth convention, when the file has it: the confidence figures are
     // reported under both.
     let other_coverage = match args.truth_coverage {
@@ -140,13 +145,20 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
     }
     let rows: Vec<TruthRow> = lines.into_iter().map(|(_, r)| r).collect();
     // Predictions are read and matched before any detector runs: a bad file fails fast.
-    let coco = args.coco.clone().unwrap_or_else(|| images.join("coco.json"));
+    let coco = args
+        .coco
+        .clone()
+        .unwrap_or_else(|| images.join("coco.json"));
     let mut predicted = Vec::new();
     for spec in &args.predictions {
         let (name, file) = predictions::parse_spec(spec)?;
-        for set in predictions::read_predictions(&file, &name, Some(&coco)).map_err(|e| e.to_string())? {
+        for set in
+            predictions::read_predictions(&file, &name, Some(&coco)).map_err(|e| e.to_string())?
+        {
             if options.methods.iter().any(|m| m.name() == set.name)
-                || predicted.iter().any(|(s, _): &(PredictionSet, _)| s.name == set.name)
+                || predicted
+                    .iter()
+                    .any(|(s, _): &(PredictionSet, _)| s.name == set.name)
             {
                 return Err(format!(
                     "{}: the name `{}` is taken: give it another with NAME={}",
@@ -163,8 +175,10 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
         Vec::new()
     } else {
         let bar = progress::bar(rows.len(), "frames");
-        let s = scoring::score(images, &rows, &options, &DetectorBank::default, &|| bar.inc(1))
-            .map_err(|e| e.to_string())?;
+        let s = scoring::score(images, &rows, &options, &DetectorBank::default, &|| {
+            bar.inc(1)
+        })
+        .map_err(|e| e.to_string())?;
         bar.finish_and_clear();
         s
     };

@@ -342,7 +342,14 @@ mod tests {
         assert_eq!(d[3].gap(), None);
         let gap = max_gap(&d).unwrap();
         assert!((gap - (d[7].mean_score - 1.0 / 3.0)).abs() < 1e-12, "{gap}");
-        for (s, k) in [(0.0, 0), (0.1, 1), (0.7, 7), (0.3, 3), (0.999_999_9, 9), (1.0, 9)] {
+        for (s, k) in [
+            (0.0, 0),
+            (0.1, 1),
+            (0.7, 7),
+            (0.3, 3),
+            (0.999_999_9, 9),
+            (1.0, 9),
+        ] {
             assert_eq!(decile_of(s), k, "{s}");
         }
     }

@@ -131,10 +131,10 @@ fn at(path: &Path, line: usize) -> String {
 
 /// A box from four coordinates: x0 < x1 and y0 < y1, each in 0..=65535.
 fn make_box(c: [f64; 4]) -> Result<Roi, String> {
-    if c.iter().any(|v| !v.is_finite() || *v < 0.0 || *v > f64::from(u16::MAX)) {
-        return Err(format!(
-            "box {c:?}: expected coordinates in 0..=65535"
-        ));
+    if c.iter()
+        .any(|v| !v.is_finite() || *v < 0.0 || *v > f64::from(u16::MAX))
+    {
+        return Err(format!("box {c:?}: expected coordinates in 0..=65535"));
     }
     let [x0, y0, x1, y1] = c.map(|v| v.round() as u16);
     if x0 >= x1 || y0 >= y1 {
@@ -160,8 +160,8 @@ fn read_json_lines(path: &Path, name: &str, text: &str) -> Result<Vec<Prediction
             continue;
         }
         let fail = |what: String| EvalError(format!("{}: {what}", at(path, i + 1)));
-        let v: Value = serde_json::from_str(line)
-            .map_err(|e| fail(format!("not a JSON object: {e}")))?;
+        let v: Value =
+            serde_json::from_str(line).map_err(|e| fail(format!("not a JSON object: {e}")))?;
         let file = v["file"]
             .as_str()
             .ok_or_else(|| fail("no \"file\" string".into()))?
@@ -261,7 +261,10 @@ fn read_csv(path: &Path, name: &str, text: &str) -> Result<PredictionSet, EvalEr
             }
             Some(make_box(c).map_err(fail)?)
         };
-        let score = match score_col.and_then(|c| cols.get(c)).filter(|s| !s.is_empty()) {
+        let score = match score_col
+            .and_then(|c| cols.get(c))
+            .filter(|s| !s.is_empty())
+        {
             None => f64::from(u8::from(bbox.is_some())),
             Some(s) => s
                 .parse::<f64>()
@@ -319,14 +322,16 @@ fn read_coco_results(
     let v: Value = serde_json::from_str(text)
         .map_err(|e| EvalError(format!("{}: not JSON: {e}", path.display())))?;
     let entries = v.as_array().ok_or_else(|| {
-        EvalError(format!("{}: expected a JSON array of results", path.display()))
+        EvalError(format!(
+            "{}: expected a JSON array of results",
+            path.display()
+        ))
     })?;
     // Best result per image: (index in `predictions`, score).
     let mut best: BTreeMap<u64, usize> = BTreeMap::new();
     let mut predictions: Vec<Prediction> = Vec::new();
     for (k, e) in entries.iter().enumerate() {
-        let fail =
-            |what: String| EvalError(format!("{}: entry {}: {what}", path.display(), k + 1));
+        let fail = |what: String| EvalError(format!("{}: entry {}: {what}", path.display(), k + 1));
         let id = e["image_id"]
             .as_u64()
             .ok_or_else(|| fail("no integer \"image_id\"".into()))?;
@@ -474,8 +479,7 @@ mod tests {
         );
         assert!(parse_spec("=a.csv").is_err());
         let rows = [row("a.png", [0; 4]), row("sub/b.png", [0; 4])];
-        let index: BTreeMap<&str, usize> =
-            [("a.png", 0), ("sub/b.png", 1)].into_iter().collect();
+        let index: BTreeMap<&str, usize> = [("a.png", 0), ("sub/b.png", 1)].into_iter().collect();
         assert_eq!(match_file("a.png", &index), Some(0));
         assert_eq!(match_file("/tmp/ds/a.png", &index), Some(0));
         assert_eq!(match_file("/tmp/ds/sub/b.png", &index), Some(1));
@@ -505,7 +509,10 @@ mod tests {
         };
         let s = score_predictions(&set, &rows).unwrap();
         assert_eq!(s.len(), 3);
-        assert_eq!((s[0].iou, s[0].score, s[0].bbox), (0.5, 0.4, Some([0, 0, 10, 5])));
+        assert_eq!(
+            (s[0].iou, s[0].score, s[0].bbox),
+            (0.5, 0.4, Some([0, 0, 10, 5]))
+        );
         assert_eq!((s[1].iou, s[1].bbox, s[2].bbox), (0.0, None, None));
         let mut twice = set.clone();
         twice.predictions.push(Prediction {

@@ -636,7 +636,7 @@ fn score_sequence(
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
-                let frame = read_row_frame_with(images, row, options)?;
+        let frame = read_row_frame_with(images, row, options)?;
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
@@ -663,9 +663,9 @@ pub fn with_truth(scores: &[FrameScore], truth: &BTreeMap<&str, Roi>) -> Vec<Fra
             let mut s = s.clone();
             if let Some(t) = truth.get(s.file.as_str()) {
                 s.truth = t.to_array();
-                s.iou = s.bbox.map_or(0.0, |[x0, y0, x1, y1]| {
-                    Roi::new(x0, y0, x1, y1).iou(t)
-                });
+                s.iou = s
+                    .bbox
+                    .map_or(0.0, |[x0, y0, x1, y1]| Roi::new(x0, y0, x1, y1).iou(t));
             }
             s
         })
@@ -829,8 +829,9 @@ pub fn write_reports(
 ) -> Result<(), EvalError> {
     let io = |p: &Path, e: std::io::Error| EvalError(format!("{}: cannot write: {e}", p.display()));
     std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
-    let mut csv =
-        String::from("file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us,score\n");
+    let mut csv = String::from(
+        "file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us,score\n",
+    );
     // No target: empty truth fields, as in `truth.csv`.
     for s in scores {
         let b = s.bbox.map_or(",,,".to_string(), |b| {
@@ -867,7 +868,8 @@ pub fn write_reports(
             g.target_frames,
             g.false_alarm_rate,
             g.auc.map_or(String::new(), |v| format!("{v:.4}")),
-            g.calibration_gap.map_or(String::new(), |v| format!("{v:.4}")),
+            g.calibration_gap
+                .map_or(String::new(), |v| format!("{v:.4}")),
         ));
     }
     let p = out.join("summary.csv");

@@ -130,7 +130,11 @@ pub const MAX_DECODE_SIDE_PX: usize = 4096;
 /// The default FITS offset, DN: [`FIXED_GAIN_PEDESTAL_DN`] (1024) for float data (BITPIX
 /// −32/−64: differenced or calibrated frames that go negative), 0 for integer data.
 pub fn default_fits_offset_dn(bitpix: i32) -> f64 {
-    if bitpix < 0 { FIXED_GAIN_PEDESTAL_DN } else { 0.0 }
+    if bitpix < 0 {
+        FIXED_GAIN_PEDESTAL_DN
+    } else {
+        0.0
+    }
 }
 
 /// The module's FITS rule: `clamp(round(v + offset), 0, 2^bits − 1)` per value; also
@@ -223,7 +227,10 @@ pub fn frame_dimensions(
     let (w, h) = if is_fits(path) {
         let img = fits::read_fits(path).map_err(|e| FrameFileError {
             path: path.to_path_buf(),
-            problem: e.strip_prefix(&format!("{}: ", path.display())).unwrap_or(&e).to_string(),
+            problem: e
+                .strip_prefix(&format!("{}: ", path.display()))
+                .unwrap_or(&e)
+                .to_string(),
         })?;
         (img.width, img.height)
     } else {
@@ -275,7 +282,7 @@ pub fn read_frame_with(
         })
     };
     let mut warnings = Vec::new();
-    let frame = if is_fits(path) {
+    let (frame, cropped) = if is_fits(path) {
         let img = fits::read_fits(path).map_err(|e| FrameFileError {
             path: path.to_path_buf(),
             problem: e
@@ -286,11 +293,26 @@ pub fn read_frame_with(
         if img.width > limit_w || img.height > limit_h {
             return Err(too_large(img.width, img.height));
         }
-        let bits = options.bits.unwrap_or(tirroi_core::frame::DEFAULT_BIT_DEPTH);
+        let bits = options
+            .bits
+            .unwrap_or(tirroi_core::frame::DEFAULT_BIT_DEPTH);
         let offset = options
             .fits_offset_dn
             .unwrap_or_else(|| default_fits_offset_dn(img.bitpix));
-        let (pixels, clamped) = fits_to_dn(&img.pixels, img.width, offset, bits).map_err(fail)?;
+        // Crop first: only the kept values are mapped (and counted when clamped).
+        let (values, width, height) = match options.crop {
+            Some(c) => {
+                check_crop(c, img.width, img.height).map_err(fail)?;
+                let [x0, y0, x1, y1] = c;
+                let mut v = Vec::with_capacity((x1 - x0) * (y1 - y0));
+                for y in y0..y1 {
+                    v.extend_from_slice(&img.pixels[y * img.width + x0..y * img.width + x1]);
+                }
+                (v, x1 - x0, y1 - y0)
+            }
+            None => (img.pixels, img.width, img.height),
+        };
+        let (pixels, clamped) = fits_to_dn(&values, width, offset, bits).map_err(fail)?;
         if clamped > 0 {
             warnings.push(format!(
                 "{clamped} of {} values clamped to 0..={} DN (FITS rule: round(value + {offset}) at {bits} bits; see --fits-offset, --bits)",
@@ -300,11 +322,11 @@ pub fn read_frame_with(
         }
         let frame = FrameBuf {
             pixels,
-            width: img.width,
-            height: img.height,
+            width,
+            height,
             bits,
         };
-        frame
+        (frame, true)
     } else {
         let open = || -> Result<ImageReader<std::io::BufReader<std::fs::File>>, FrameFileError> {
             let reader = ImageReader::open(path)
@@ -376,11 +398,11 @@ pub fn read_frame_with(
             height,
             bits,
         };
-        frame
+        (frame, false)
     };
     let frame = match options.crop {
-        Some(c) => frame.crop(c).map_err(fail)?,
-        None => frame,
+        Some(c) if !cropped => frame.crop(c).map_err(fail)?,
+        _ => frame,
     };
     if frame.width > max_w || frame.height > max_h {
         return Err(too_large(frame.width, frame.height));
