@@ -329,6 +329,10 @@ pub fn read_truth_lines(
     Ok(rows)
 }
 
+/// The size of a frame file (width, height, px) by its `truth.csv` name, as
+/// [`check_truth_boxes`] takes it.
+pub type FrameSize<'a> = dyn Fn(&str) -> Result<(usize, usize), EvalError> + Sync + 'a;
+
 /// Checks that every truth box lies inside its frame, reading each frame's size from
 /// its file header only (`dimensions(file)`, e.g.
 /// [`frame_dimensions`](crate::imaging::image_io::frame_dimensions) after a crop).
@@ -339,7 +343,7 @@ pub fn read_truth_lines(
 pub fn check_truth_boxes(
     truth: &Path,
     rows: &[(usize, TruthRow)],
-    dimensions: &(dyn Fn(&str) -> Result<(usize, usize), EvalError> + Sync),
+    dimensions: &FrameSize<'_>,
 ) -> Result<(), EvalError> {
     rows.par_iter()
         .filter(|(_, r)| r.has_target())
