@@ -14,6 +14,12 @@ use cli_common::{run, tirroi};
 use tirroi::host::imaging::fits::read_fits;
 use tirroi::host::imaging::image_io::{HAYABUSA2_TIR_CROP, ReadOptions, read_frame_with};
 
+/// A box `[x0, y0, x1, y1)`, or none.
+type Bbox = Option<[u16; 4]>;
+
+/// A frame as the brute-force count sees it: truth, predicted box, its score.
+type Frame = (Bbox, Bbox, f64);
+
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
@@ -68,7 +74,7 @@ fn col(header: &[String], name: &str) -> usize {
 
 /// The fixture frames with a truth where the first frame is declared without a target
 /// (a box on it is a false alarm); returns the directory and the truth boxes.
-fn fixtures_with_an_empty_frame() -> (tempfile::TempDir, Vec<(String, Option<[u16; 4]>)>) {
+fn fixtures_with_an_empty_frame() -> (tempfile::TempDir, Vec<(String, Bbox)>) {
     let dir = tempfile::tempdir().unwrap();
     ok(&run(&["fixtures", "--out", s(dir.path())]));
     let (_, rows) = csv(&dir.path().join("truth.csv"));
@@ -99,7 +105,7 @@ fn iou(a: [u16; 4], b: [u16; 4]) -> f64 {
 
 /// Mean IoU, hit rate, false-alarm rate and AUC of (truth, box, score) frames, by the
 /// definitions counted pair by pair (docs/results.md § Confidence).
-fn brute(frames: &[(Option<[u16; 4]>, Option<[u16; 4]>, f64)]) -> (f64, f64, f64, Option<f64>) {
+fn brute(frames: &[Frame]) -> (f64, f64, f64, Option<f64>) {
     let mut ious = Vec::new();
     let (mut empty, mut alarms) = (0, 0);
     let mut pos = Vec::new();
@@ -320,7 +326,7 @@ fn csv_and_coco_predictions_against_a_brute_force_count() {
         out.contains("| mine | all |") && out.contains("| coco | all |"),
         "{out}"
     );
-    let frames: Vec<(Option<[u16; 4]>, Option<[u16; 4]>, f64)> = truth
+    let frames: Vec<Frame> = truth
         .iter()
         .zip(&boxes)
         .map(|((_, t), (b, sc))| (*t, *b, *sc))
