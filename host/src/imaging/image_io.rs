@@ -283,7 +283,7 @@ pub fn read_frame_with(
     };
     let mut warnings = Vec::new();
     let (frame, cropped) = if is_fits(path) {
-        let img = fits::read_fits(path).map_err(|e| FrameFileError {
+        let img = fits::read_fits_within(path, limit_w, limit_h).map_err(|e| FrameFileError {
             path: path.to_path_buf(),
             problem: e
                 .strip_prefix(&format!("{}: ", path.display()))
