@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::EXIT_BAD_INPUT;
 use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
-use crate::imaging::image_io::read_frame;
+use crate::imaging::image_io::{ReadOptions, parse_crop, read_frame_with};
 
 /// The options of `tirroi detect`.
 #[derive(Debug, clap::Args)]
@@ -27,7 +27,20 @@ pub struct DetectArgs {
     /// DN fit, else 16).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
-    /// Frames to process.
+    /// Mask-to-box rule for every detector: largest-component or all-foreground
+    /// (default: each detector's own; `eval` uses largest-component unless told).
+    #[arg(long, value_parser = super::eval::parse_box_rule)]
+    pub box_rule: Option<tirroi_core::BoxRule>,
+    /// FITS frames: DN added to each value before rounding and clamping to the bit
+    /// depth (default: 1024 for float data, 0 for integer data; docs/cli.md § FITS).
+    #[arg(long, value_name = "DN", allow_negative_numbers = true)]
+    pub fits_offset: Option<f64>,
+    /// Detect only in this part of every frame: x0,y0,x1,y1 (px, x1 and y1 exclusive)
+    /// or hayabusa2-tir (the TIR's 328x248 effective area of its 384x256 FITS frames);
+    /// boxes are in the cropped frame.
+    #[arg(long, value_parser = parse_crop)]
+    pub crop: Option<[usize; 4]>,
+    /// Frames to process (PNG, TIFF or FITS).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
 }
@@ -55,12 +68,25 @@ pub fn run(args: &DetectArgs) -> ExitCode {
         &args.files,
     );
     let mut bank = DetectorBank::default();
+    if let Some(rule) = args.box_rule {
+        bank.set_box_rule(rule);
+    }
     let mut failed = false;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     for path in files {
-        let frame = match read_frame(path, bits) {
-            Ok(f) => f,
+        let options = ReadOptions {
+            bits,
+            fits_offset_dn: args.fits_offset,
+            crop: args.crop,
+        };
+        let frame = match read_frame_with(path, &options) {
+            Ok((f, warnings)) => {
+                for w in warnings {
+                    eprintln!("tirroi: warning: {}: {w}", path.display());
+                }
+                f
+            }
             Err(e) => {
                 eprintln!("tirroi: error: {e}");
                 failed = true;

@@ -75,7 +75,7 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Detect the ROI in 8/16-bit grayscale PNG (or TIFF) frames.
+    /// Detect the ROI in 8/16-bit grayscale PNG, TIFF or FITS frames.
     ///
     /// One line per frame and method: the box [x0, y0, x1, y1] (x1, y1 exclusive; none
     /// when no pixel is foreground), the score (confidence 0-1 that the box is the
@@ -128,10 +128,12 @@ pub enum Command {
     /// Fit the camera's own signature (shading, column/row pattern, hot and dead pixels,
     /// per-pixel residual, gain) on a real FITS frame and write the calibration TOML.
     SensorFit(sensor_fit::SensorFitArgs),
-    /// Score detectors on a directory of 16-bit PNG frames with a truth.csv: mean and
-    /// median IoU, hit rate (IoU >= 0.5) and core time per method and per group
-    /// (mode, scale, target, material, illumination, range band). Markdown on stdout;
-    /// scores.csv, summary.csv and summary.json in --out.
+    /// Score detectors (and --predictions made elsewhere) on a directory of PNG, TIFF
+    /// or FITS frames with a truth.csv: mean and median IoU, hit rate (IoU >= 0.5),
+    /// false alarms, AUC and calibration of the confidence, and core time per method
+    /// and per group (mode, scale, target, material, illumination, range band, SCR).
+    /// Markdown on stdout; scores.csv, summary.csv, summary.json, confidence.csv and
+    /// calibration.csv in --out.
     Eval(eval::EvalArgs),
     /// Reproduce the paper's results: render (or reuse) the datasets, score every
     /// detector, print Tables 6, 7 and 8 beside the paper's, and write the figures.

@@ -14,12 +14,16 @@
 //!
 //! **The scoring definition** (one everywhere: `tirroi eval`, `tune`, `paper`'s tables
 //! and plots; `docs/results.md` § Scoring). A frame has a target when its truth box is
-//! not empty (empty `x0..y1` fields, or a zero-area box as older files wrote for a
-//! target out of view, mean *no target*). Over a group's frames with a target: mean
+//! not empty (empty `x0..y1` fields mean *no target*; a zero-area box is an error). Over a group's frames with a target: mean
 //! and median IoU (a frame where the detector returned no box scores 0) and the hit
 //! rate, the share with IoU ≥ [`HIT_IOU`]. Over its frames without a target: the
 //! false-alarm rate, the share where the detector returned any box. Times are over
-//! all frames.
+//! all frames. The detector's confidence (`FrameScore::score`) gives each group its
+//! AUC and calibration by the definitions of [`crate::eval::confidence`].
+//!
+//! **Truth validation** ([`read_truth_lines`], [`check_truth_boxes`]): a header-only
+//! file, a frame listed twice, a zero-area box and a box reaching outside its frame are
+//! errors naming the file and line.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -30,7 +34,8 @@ use serde::Serialize;
 use tirroi_core::{BoxRule, Method, Roi};
 
 use crate::eval::bank::{DetectorBank, median};
-use crate::imaging::image_io::read_frame;
+use crate::eval::confidence::{self, Outcome};
+use crate::imaging::image_io::{ReadOptions, read_frame, read_frame_with};
 use crate::seed::{fnv1a64, stir};
 
 /// A row of `truth.csv`.
@@ -73,6 +78,14 @@ pub enum TruthCoverage {
 }
 
 impl TruthCoverage {
+    /// `half` or `quarter`, as `--truth-coverage` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TruthCoverage::Half => "half",
+            TruthCoverage::Quarter => "quarter",
+        }
+    }
+
     /// `half` or `quarter`.
     pub fn from_name(name: &str) -> Option<TruthCoverage> {
         match name {
@@ -149,14 +162,30 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthRow>, EvalError> {
     read_truth_with(path, TruthCoverage::Half)
 }
 
-/// Reads `truth.csv` with the box of `coverage`. Four empty box fields mean no target
-/// (as does a zero-area box).
+/// Reads `truth.csv` with the box of `coverage`. Four empty box fields mean no target.
+///
+/// # Errors
+/// As [`read_truth_lines`].
+pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<TruthRow>, EvalError> {
+    Ok(read_truth_lines(path, coverage)?
+        .into_iter()
+        .map(|(_, r)| r)
+        .collect())
+}
+
+/// Reads `truth.csv` with the box of `coverage`, each row with its line number (1-based,
+/// the header is line 1). Four empty box fields mean no target.
 ///
 /// # Errors
 /// [`EvalError`] naming the file and line for a missing header (or missing quarter
-/// columns for [`TruthCoverage::Quarter`]), a short row, or a box that is neither four
-/// empty fields nor four integers with x0 ≤ x1, y0 ≤ y1.
-pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<TruthRow>, EvalError> {
+/// columns for [`TruthCoverage::Quarter`]), a file with no row after the header, a
+/// short row, a frame listed twice (both lines named), or a box that is neither four
+/// empty fields nor four integers with x0 < x1, y0 < y1 (a zero-area box is refused:
+/// write four empty fields for a frame without a target).
+pub fn read_truth_lines(
+    path: &Path,
+    coverage: TruthCoverage,
+) -> Result<Vec<(usize, TruthRow)>, EvalError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| EvalError(format!("{}: cannot read: {e}", path.display())))?;
     let mut lines = text.lines().enumerate();
@@ -188,6 +217,7 @@ pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<Truth
         }
     };
     let mut rows = Vec::new();
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
     for (i, line) in lines {
         if line.trim().is_empty() {
             continue;
@@ -221,6 +251,20 @@ pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<Truth
             return Err(EvalError(format!(
                 "{}: box {b:?}: expected x0 <= x1 and y0 <= y1",
                 at()
+            )));
+        }
+        if !empty && (b[0] == b[2] || b[1] == b[3]) {
+            return Err(EvalError(format!(
+                "{}: box {b:?} has zero area: expected x0 < x1 and y0 < y1 (four empty box fields for a frame without a target)",
+                at()
+            )));
+        }
+        if let Some(first) = seen.insert(cols[0].to_string(), i + 1) {
+            return Err(EvalError(format!(
+                "{}: `{}` is listed twice (lines {first} and {}): expected one row per frame",
+                at(),
+                cols[0],
+                i + 1
             )));
         }
         let roi = Roi::new(b[0], b[1], b[2], b[3]);
@@ -261,25 +305,69 @@ pub fn read_truth_with(path: &Path, coverage: TruthCoverage) -> Result<Vec<Truth
                 }
             }
         }
-        rows.push(TruthRow {
-            file: cols[0].to_string(),
-            roi,
-            groups,
-            range_m,
-            bits,
-            signal_to_clutter,
-        });
+        rows.push((
+            i + 1,
+            TruthRow {
+                file: cols[0].to_string(),
+                roi,
+                groups,
+                range_m,
+                bits,
+                signal_to_clutter,
+            },
+        ));
+    }
+    if rows.is_empty() {
+        return Err(EvalError(format!(
+            "{}:1: only a header: expected at least one row `file,x0,y0,x1,y1` after it",
+            path.display()
+        )));
     }
     if !header.contains(&"signal_to_clutter") {
-        scr_from_metadata(path, &mut rows);
+        scr_from_metadata(path, rows.iter_mut().map(|(_, r)| r));
     }
     Ok(rows)
+}
+
+/// The size of a frame file (width, height, px) by its `truth.csv` name, as
+/// [`check_truth_boxes`] takes it.
+pub type FrameSize<'a> = dyn Fn(&str) -> Result<(usize, usize), EvalError> + Sync + 'a;
+
+/// Checks that every truth box lies inside its frame, reading each frame's size from
+/// its file header only (`dimensions(file)`, e.g.
+/// [`frame_dimensions`](crate::imaging::image_io::frame_dimensions) after a crop).
+///
+/// # Errors
+/// [`EvalError`] naming `truth` and the line of the first box reaching past its frame's
+/// width or height, or the frame file when its header cannot be read.
+pub fn check_truth_boxes(
+    truth: &Path,
+    rows: &[(usize, TruthRow)],
+    dimensions: &FrameSize<'_>,
+) -> Result<(), EvalError> {
+    rows.par_iter()
+        .filter(|(_, r)| r.has_target())
+        .map(|(line, r)| {
+            let (w, h) = dimensions(&r.file)?;
+            let b = r.roi;
+            if usize::from(b.x1) > w || usize::from(b.y1) > h {
+                return Err(EvalError(format!(
+                    "{}:{line}: box {:?} reaches outside the {w}x{h} px frame `{}`: expected x1 <= {w} and y1 <= {h}",
+                    truth.display(),
+                    b.to_array(),
+                    r.file
+                )));
+            }
+            Ok(())
+        })
+        .collect::<Result<Vec<()>, EvalError>>()
+        .map(|_| ())
 }
 
 /// For a `truth.csv` without a `signal_to_clutter` column: the ratios of the
 /// `metadata.jsonl` beside it (the dataset's, by file name), when there is one.
 /// Unreadable lines and files are skipped: the ratio only adds a group.
-fn scr_from_metadata(truth: &Path, rows: &mut [TruthRow]) {
+fn scr_from_metadata<'a>(truth: &Path, rows: impl Iterator<Item = &'a mut TruthRow>) {
     let Some(text) = truth
         .parent()
         .and_then(|d| std::fs::read_to_string(d.join("metadata.jsonl")).ok())
@@ -294,7 +382,7 @@ fn scr_from_metadata(truth: &Path, rows: &mut [TruthRow]) {
             }
         }
     }
-    for row in rows.iter_mut().filter(|r| r.has_target()) {
+    for row in rows.filter(|r| r.has_target()) {
         if let Some(&r) = by_file.get(&row.file) {
             if r.is_finite() {
                 row.groups.push(("scr".into(), scr_bin(r).into()));
@@ -309,10 +397,13 @@ fn scr_from_metadata(truth: &Path, rows: &mut [TruthRow]) {
 pub struct FrameScore {
     /// Frame file.
     pub file: String,
-    /// Method name.
-    pub method: &'static str,
+    /// Method name (a built-in method, or the name of a predictions file).
+    pub method: String,
     /// Predicted box, `None` when nothing was found.
     pub bbox: Option<[u16; 4]>,
+    /// The detector's confidence in its box, 0–1 (0 without a box; 1 for a predicted
+    /// box without a score).
+    pub score: f32,
     /// Truth box (all 0: no target).
     pub truth: [u16; 4],
     /// IoU of prediction and truth (0 when none, and on a frame without a target).
@@ -342,6 +433,16 @@ impl FrameScore {
     pub fn false_alarm(&self) -> bool {
         !self.has_target() && self.detected()
     }
+
+    /// The frame as the confidence measures see it ([`confidence::Outcome`]).
+    pub fn outcome(&self) -> Outcome {
+        let has_target = self.has_target();
+        Outcome {
+            has_target,
+            score: self.detected().then_some(self.score),
+            hit: has_target && self.detected() && self.iou >= HIT_IOU,
+        }
+    }
 }
 
 /// How to run an evaluation.
@@ -359,6 +460,22 @@ pub struct EvalOptions {
     pub bits: Option<u8>,
     /// Where `auto` gets its tracking prior (the other methods have none).
     pub track: Track,
+    /// FITS frames: DN added before rounding (`None`: the default of
+    /// [`crate::imaging::image_io::default_fits_offset_dn`]).
+    pub fits_offset_dn: Option<f64>,
+    /// Part of every frame to score, `[x0, y0, x1, y1)` px (truth boxes are in it).
+    pub crop: Option<[usize; 4]>,
+}
+
+impl EvalOptions {
+    /// How to read a frame whose own bit depth (`truth.csv`'s `bits`) is `row_bits`.
+    pub fn read_options(&self, row_bits: Option<u8>) -> ReadOptions {
+        ReadOptions {
+            bits: row_bits.or(self.bits),
+            fits_offset_dn: self.fits_offset_dn,
+            crop: self.crop,
+        }
+    }
 }
 
 /// Where `auto` gets its tracking prior during an evaluation ([`EvalOptions::track`]).
@@ -425,7 +542,7 @@ pub fn score(
             },
             |bank, row| {
                 let path: PathBuf = images.join(&row.file);
-                let frame = read_row_frame(images, row, options.bits)?;
+                let frame = read_row_frame_with(images, row, options)?;
                 let view = frame
                     .view()
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
@@ -462,6 +579,21 @@ pub fn read_row_frame(
     read_frame(&images.join(&row.file), row.bits.or(bits)).map_err(|e| EvalError(e.to_string()))
 }
 
+/// [`read_row_frame`] under every reading option of `options` (bit depth, FITS offset,
+/// crop); warnings are dropped.
+///
+/// # Errors
+/// [`EvalError`] naming the file when it cannot be read.
+pub fn read_row_frame_with(
+    images: &Path,
+    row: &TruthRow,
+    options: &EvalOptions,
+) -> Result<crate::imaging::image_io::FrameBuf, EvalError> {
+    read_frame_with(&images.join(&row.file), &options.read_options(row.bits))
+        .map(|(f, _)| f)
+        .map_err(|e| EvalError(e.to_string()))
+}
+
 /// Runs `method` on one frame (`repeat` times, median time) and scores its box against
 /// the row's truth; also returns the box.
 fn score_one(
@@ -477,8 +609,9 @@ fn score_one(
         .map_err(|e| EvalError(format!("{}: {method}: {e}", path.display())))?;
     let score = FrameScore {
         file: row.file.clone(),
-        method: method.name(),
+        method: method.name().to_string(),
         bbox: d.roi.map(|r| r.to_array()),
+        score: if d.roi.is_some() { d.score() } else { 0.0 },
         truth: row.roi.to_array(),
         iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
         time_us,
@@ -507,7 +640,7 @@ fn score_sequence(
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
-        let frame = read_row_frame(images, row, options.bits)?;
+        let frame = read_row_frame_with(images, row, options)?;
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
@@ -522,6 +655,25 @@ fn score_sequence(
         progress();
     }
     Ok(scores)
+}
+
+/// The same scores against other truth boxes (e.g. the other [`TruthCoverage`]), by
+/// file: truth and IoU replaced, boxes and scores kept; a file missing from `truth`
+/// keeps its box.
+pub fn with_truth(scores: &[FrameScore], truth: &BTreeMap<&str, Roi>) -> Vec<FrameScore> {
+    scores
+        .iter()
+        .map(|s| {
+            let mut s = s.clone();
+            if let Some(t) = truth.get(s.file.as_str()) {
+                s.truth = t.to_array();
+                s.iou = s
+                    .bbox
+                    .map_or(0.0, |[x0, y0, x1, y1]| Roi::new(x0, y0, x1, y1).iou(t));
+            }
+            s
+        })
+        .collect()
 }
 
 /// Statistics of one method over one group of frames.
@@ -550,6 +702,12 @@ pub struct GroupStats {
     pub mean_time_ms: f64,
     /// Median core time per frame, ms.
     pub median_time_ms: f64,
+    /// Area under the hit-rate / false-positive-rate curve of the confidence
+    /// ([`confidence::auc`]); `None` without frames with a target or without negatives.
+    pub auc: Option<f64>,
+    /// Largest `|hit rate − mean score|` over the score deciles holding boxes
+    /// ([`confidence::max_gap`]); `None` without boxes.
+    pub calibration_gap: Option<f64>,
 }
 
 /// Statistics of a set of scores, by the module's scoring definition.
@@ -564,6 +722,7 @@ pub fn stats(method: &str, group: &str, value: &str, scores: &[&FrameScore]) -> 
     let empty = n - targets;
     let alarms = scores.iter().filter(|s| s.false_alarm()).count();
     let mut times: Vec<f64> = scores.iter().map(|s| s.time_us * 1e-3).collect();
+    let outcomes: Vec<Outcome> = scores.iter().map(|s| s.outcome()).collect();
     let mean = |v: &[f64]| {
         if v.is_empty() {
             0.0
@@ -591,15 +750,17 @@ pub fn stats(method: &str, group: &str, value: &str, scores: &[&FrameScore]) -> 
         median_iou: median(&mut ious),
         mean_time_ms: mean(&times),
         median_time_ms: median(&mut times),
+        auc: confidence::auc(&outcomes),
+        calibration_gap: confidence::max_gap(&confidence::calibration(&outcomes)),
     }
 }
 
 /// Per method: all frames, then each value of each group column present.
 pub fn summarise(scores: &[FrameScore]) -> Vec<GroupStats> {
-    let mut methods: Vec<&'static str> = Vec::new();
+    let mut methods: Vec<&str> = Vec::new();
     for s in scores {
-        if !methods.contains(&s.method) {
-            methods.push(s.method);
+        if !methods.contains(&s.method.as_str()) {
+            methods.push(&s.method);
         }
     }
     let mut out = Vec::new();
@@ -622,7 +783,7 @@ pub fn summarise(scores: &[FrameScore]) -> Vec<GroupStats> {
 /// The statistics as a Markdown table.
 pub fn markdown(stats: &[GroupStats]) -> String {
     let mut s = String::from(
-        "| method | group | frames | mean IoU | median IoU | IoU >= 0.5 | target frames | false alarms | mean time [ms] | median time [ms] |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| method | group | frames | mean IoU | median IoU | IoU >= 0.5 | target frames | false alarms | AUC | calib. gap | mean time [ms] | median time [ms] |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for g in stats {
         let group = if g.group == "all" {
@@ -643,14 +804,17 @@ pub fn markdown(stats: &[GroupStats]) -> String {
         } else {
             format!("{:.3}", g.false_alarm_rate)
         };
+        let opt = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |v| format!("{v:.3}"));
         s.push_str(&format!(
-            "| {} | {group} | {} | {} | {} | {} | {} | {alarms} | {:.3} | {:.3} |\n",
+            "| {} | {group} | {} | {} | {} | {} | {} | {alarms} | {} | {} | {:.3} | {:.3} |\n",
             g.method,
             g.frames,
             iou(g.mean_iou),
             iou(g.median_iou),
             iou(g.hit_rate),
             g.target_frames,
+            opt(g.auc),
+            opt(g.calibration_gap),
             g.mean_time_ms,
             g.median_time_ms
         ));
@@ -669,8 +833,9 @@ pub fn write_reports(
 ) -> Result<(), EvalError> {
     let io = |p: &Path, e: std::io::Error| EvalError(format!("{}: cannot write: {e}", p.display()));
     std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
-    let mut csv =
-        String::from("file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us\n");
+    let mut csv = String::from(
+        "file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us,score\n",
+    );
     // No target: empty truth fields, as in `truth.csv`.
     for s in scores {
         let b = s.bbox.map_or(",,,".to_string(), |b| {
@@ -683,18 +848,18 @@ pub fn write_reports(
             ",,,".to_string()
         };
         csv.push_str(&format!(
-            "{},{},{b},{t},{:.4},{:.2}\n",
-            s.file, s.method, s.iou, s.time_us
+            "{},{},{b},{t},{:.4},{:.2},{:.3}\n",
+            s.file, s.method, s.iou, s.time_us, s.score
         ));
     }
     let p = out.join("scores.csv");
     std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
     let mut csv = String::from(
-        "method,group,value,frames,mean_iou,median_iou,hit_rate,mean_time_ms,median_time_ms,target_frames,false_alarm_rate\n",
+        "method,group,value,frames,mean_iou,median_iou,hit_rate,mean_time_ms,median_time_ms,target_frames,false_alarm_rate,auc,calibration_gap\n",
     );
     for g in stats {
         csv.push_str(&format!(
-            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{:.4}\n",
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{:.4},{},{}\n",
             g.method,
             g.group,
             g.value,
@@ -706,6 +871,9 @@ pub fn write_reports(
             g.median_time_ms,
             g.target_frames,
             g.false_alarm_rate,
+            g.auc.map_or(String::new(), |v| format!("{v:.4}")),
+            g.calibration_gap
+                .map_or(String::new(), |v| format!("{v:.4}")),
         ));
     }
     let p = out.join("summary.csv");
@@ -723,8 +891,9 @@ mod tests {
     fn score(iou: f32, time_us: f64, groups: &[(&str, &str)]) -> FrameScore {
         FrameScore {
             file: "f.png".into(),
-            method: "otsu",
+            method: "otsu".into(),
             bbox: None,
+            score: 0.0,
             truth: [0, 0, 1, 1],
             iou,
             time_us,

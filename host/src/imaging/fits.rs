@@ -90,6 +90,19 @@ impl FitsImage {
 /// above [`MAX_FITS_SIDE`], a non-numeric BSCALE/BZERO, or data shorter than the header
 /// says.
 pub fn read_fits(path: &Path) -> Result<FitsImage, String> {
+    read_fits_within(path, MAX_FITS_SIDE, MAX_FITS_SIDE)
+}
+
+/// [`read_fits`] for an image of at most `max_width` × `max_height` px, checked from the
+/// header before any data is decoded (the caller's own limit, e.g. the core's 1024 × 768).
+///
+/// # Errors
+/// As [`read_fits`], and a side above `max_width` or `max_height`.
+pub fn read_fits_within(
+    path: &Path,
+    max_width: usize,
+    max_height: usize,
+) -> Result<FitsImage, String> {
     let name = path.display();
     let meta = std::fs::metadata(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
     if meta.len() > MAX_FITS_FILE_BYTES {
@@ -99,7 +112,7 @@ pub fn read_fits(path: &Path) -> Result<FitsImage, String> {
         ));
     }
     let bytes = std::fs::read(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    parse_fits(&bytes).map_err(|e| format!("{name}: {e}"))
+    parse_fits_within(&bytes, max_width, max_height).map_err(|e| format!("{name}: {e}"))
 }
 
 /// Parses FITS bytes held in memory (see [`read_fits`]); errors do not name a file.
@@ -107,6 +120,20 @@ pub fn read_fits(path: &Path) -> Result<FitsImage, String> {
 /// # Errors
 /// As [`read_fits`].
 pub fn parse_fits(bytes: &[u8]) -> Result<FitsImage, String> {
+    parse_fits_within(bytes, MAX_FITS_SIDE, MAX_FITS_SIDE)
+}
+
+/// [`parse_fits`] for an image of at most `max_width` × `max_height` px (and
+/// [`MAX_FITS_SIDE`]), checked from the header before the data.
+///
+/// # Errors
+/// As [`read_fits_within`].
+pub fn parse_fits_within(
+    bytes: &[u8],
+    max_width: usize,
+    max_height: usize,
+) -> Result<FitsImage, String> {
+    let (max_w, max_h) = (max_width.min(MAX_FITS_SIDE), max_height.min(MAX_FITS_SIDE));
     if bytes.len() < 2880 || !bytes.starts_with(b"SIMPLE  =") {
         return Err(
             "not a FITS file: expected a 2880-byte header block starting with `SIMPLE  =`"
@@ -144,6 +171,11 @@ pub fn parse_fits(bytes: &[u8]) -> Result<FitsImage, String> {
         if !(1..=MAX_FITS_SIDE).contains(&w) || !(1..=MAX_FITS_SIDE).contains(&h) {
             return Err(format!(
                 "HDU {index}: NAXIS1 × NAXIS2 = {w} × {h}: expected 1..={MAX_FITS_SIDE} a side"
+            ));
+        }
+        if w > max_w || h > max_h {
+            return Err(format!(
+                "image is {w}x{h} px (HDU {index}, from the header); at most {max_w}x{max_h} px are read"
             ));
         }
         let bitpix = xt.get_bitpix();
@@ -291,6 +323,14 @@ mod tests {
         let bytes = fits_bytes(&header(-32, 100_000, 2, &[]), &[]);
         let e = parse_fits(&bytes).unwrap_err();
         assert!(e.contains("100000 × 2") && e.contains("16384"), "{e}");
+    }
+
+    #[test]
+    fn a_callers_limit_is_checked_from_the_header() {
+        // 2000 × 3 and no data: a check after decoding would report the truncation.
+        let bytes = fits_bytes(&header(-32, 2000, 3, &[]), &[]);
+        let e = parse_fits_within(&bytes, 1024, 768).unwrap_err();
+        assert!(e.contains("2000x3") && e.contains("1024x768"), "{e}");
     }
 
     #[test]

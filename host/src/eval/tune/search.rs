@@ -141,6 +141,8 @@ pub fn evaluate_together(
         box_rule: None,
         bits,
         track: scoring::Track::Off,
+        fits_offset_dn: None,
+        crop: None,
     };
     let make_bank = || {
         let mut bank = DetectorBank::default();

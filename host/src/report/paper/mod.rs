@@ -197,6 +197,8 @@ fn score(
         box_rule: None,
         bits: None,
         track: scoring::Track::Off,
+        fits_offset_dn: None,
+        crop: None,
     };
     let scores = scoring::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
         bar.inc(1)
