@@ -40,8 +40,10 @@ mod images;
 mod labels;
 mod library;
 mod plan;
+pub mod testset;
 
 pub use images::ImageRecord;
+pub use labels::TRUTH_CSV_HEADER;
 pub use library::{Library, ThermalState};
 pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
