@@ -221,3 +221,71 @@ pub fn frames(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::*;
+    use crate::dataset::testset::{TestsetOptions, make_frames};
+    use crate::imaging::signature::FIXED_GAIN_PEDESTAL_DN;
+
+    fn reference() -> Option<PathBuf> {
+        let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
+        if p.join(DARK_FRAME).is_file() {
+            Some(p)
+        } else {
+            println!("SKIPPED: no reference data at {}", p.display());
+            None
+        }
+    }
+
+    #[test]
+    fn plain_frame_is_the_real_frame_on_the_pedestal_and_variants_are_seeded() {
+        let Some(r) = reference() else { return };
+        let dark = DarkFrame::load(&r).expect("dark frame");
+        // The reference README: mean −373 DN, σ 32 DN over the effective area.
+        assert!((dark.mean_dn + 373.0).abs() < 1.0, "mean {}", dark.mean_dn);
+        let opts = TestsetOptions {
+            kind: Kind::Dark,
+            count: 4,
+            seed: 9,
+            reference: r,
+            no_target_fraction: Some(0.75),
+            preview: false,
+            progress: false,
+        };
+        let bar = ProgressBar::hidden();
+        let a = make_frames(&opts, &bar).expect("frames");
+        let b = make_frames(&opts, &bar).expect("frames");
+        assert_eq!(a.len(), 4);
+        assert_eq!(a.iter().filter(|f| f.record.target == "none").count(), 3);
+        for (fa, fb) in a.iter().zip(&b) {
+            assert_eq!(fa.frame, fb.frame);
+        }
+        let plain = a
+            .iter()
+            .find(|f| f.record.noise_seed.is_none())
+            .expect("the plain frame");
+        assert_eq!(plain.record.target, "none");
+        assert_eq!(plain.frame.bits, 14);
+        // DN = D − mean D + pedestal, within the f32 radiance round trip and rounding.
+        for (i, (&dn, &d)) in plain.frame.pixels.iter().zip(&dark.dn).enumerate() {
+            let want = d - dark.mean_dn + FIXED_GAIN_PEDESTAL_DN;
+            assert!(
+                (f64::from(dn) - want).abs() <= 0.51,
+                "pixel {i}: {dn} DN vs {want:.2}"
+            );
+        }
+        // The noisy variants differ from each other and carry σ > 0.
+        let noisy: Vec<_> = a.iter().filter(|f| f.record.noise_seed.is_some()).collect();
+        assert!(noisy.iter().all(|f| f.record.noise_sigma_dn > 0.0));
+        assert_ne!(noisy[0].frame.pixels, noisy[1].frame.pixels);
+        let with = a
+            .iter()
+            .find(|f| f.record.target != "none")
+            .expect("target");
+        let [x0, y0, x1, y1] = with.record.bbox;
+        assert!(x0 < x1 && y0 < y1 && x1 <= 328 && y1 <= 248);
+    }
+}

@@ -402,4 +402,62 @@ mod tests {
         }
         assert!(Kind::parse("earth").unwrap_err().contains("real-earth"));
     }
+
+    #[test]
+    fn fixture_family_writes_same_bytes_and_valid_truth() {
+        let dir = std::env::temp_dir().join(format!("tirroi-testset-{}", std::process::id()));
+        let opts = TestsetOptions {
+            kind: Kind::Fixtures,
+            count: 10,
+            seed: 3,
+            reference: PathBuf::from("/nonexistent"),
+            no_target_fraction: None,
+            preview: false,
+            progress: false,
+        };
+        let s = write_testset(&opts, &dir.join("a")).expect("a");
+        write_testset(&opts, &dir.join("b")).expect("b");
+        assert_eq!(s.frames, 10);
+        assert_eq!(s.no_target, 2);
+        for f in ["truth.csv", "metadata.jsonl", "000000.png", "000009.png"] {
+            let a = std::fs::read(dir.join("a").join(f)).expect("read");
+            assert_eq!(
+                a,
+                std::fs::read(dir.join("b").join(f)).expect("read"),
+                "{f}"
+            );
+        }
+        // eval's reader takes both conventions; boxes lie in the frame.
+        let truth = dir.join("a").join("truth.csv");
+        for coverage in [
+            crate::eval::scoring::TruthCoverage::Half,
+            crate::eval::scoring::TruthCoverage::Quarter,
+        ] {
+            let rows = crate::eval::scoring::read_truth_with(&truth, coverage).expect("truth");
+            assert_eq!(rows.len(), 10);
+            assert_eq!(rows.iter().filter(|r| !r.has_target()).count(), 2);
+            for r in rows.iter().filter(|r| r.has_target()) {
+                assert!(r.roi.x1 <= 328 && r.roi.y1 <= 248, "{:?}", r.roi);
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn missing_reference_names_the_file() {
+        let opts = TestsetOptions {
+            kind: Kind::Dark,
+            count: 2,
+            seed: 1,
+            reference: PathBuf::from("/nonexistent/reference"),
+            no_target_fraction: None,
+            preview: false,
+            progress: false,
+        };
+        let e = make_frames(&opts, &ProgressBar::hidden()).unwrap_err().0;
+        assert!(
+            e.contains("dark_20180629_083003.fit") && e.contains("--reference"),
+            "{e}"
+        );
+    }
 }

@@ -252,3 +252,93 @@ pub fn frames(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::*;
+    use crate::dataset::testset::{TestsetOptions, make_frames};
+
+    fn reference() -> Option<PathBuf> {
+        let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
+        if p.join(EARTH_IMAGE).is_file() {
+            Some(p)
+        } else {
+            println!("SKIPPED: no reference data at {}", p.display());
+            None
+        }
+    }
+
+    #[test]
+    fn window_radiance_is_the_band_radiance_of_the_real_temperature() {
+        let Some(r) = reference() else { return };
+        let band = BandRadiance::hayabusa2_tir();
+        let earth = RealEarth::load(&r, (328, 248), &band).expect("load");
+        // The source read independently, with the `image` crate.
+        let img = image::open(r.join(EARTH_IMAGE)).expect("png").into_luma16();
+        assert!(earth.corners.len() > 100, "{} windows", earth.corners.len());
+        for (k, flip) in [
+            (0usize, 0u8),
+            (earth.corners.len() / 2, 1),
+            (earth.corners.len() - 1, 3),
+        ] {
+            let c = earth.corners[k];
+            let f = earth.window_f(c, flip);
+            for (x, y) in [(0usize, 0usize), (327, 247), (100, 50), (200, 200)] {
+                let sx = if flip & 1 == 1 { 327 - x } else { x };
+                let sy = if flip & 2 == 2 { 247 - y } else { y };
+                let v = img.get_pixel((c.0 + sx) as u32, (c.1 + sy) as u32)[0];
+                assert!(v > 0, "window {c:?} holds no-data pixel ({sx}, {sy})");
+                let t_k = f64::from(v) / 50.0;
+                assert!((224.0..=297.0).contains(&t_k), "{t_k} K");
+                let l = band.radiance_w_m2_sr(t_k, 1.0).expect("L");
+                let want = std::f64::consts::PI * l;
+                let got = f64::from(f[y * 328 + x]);
+                assert!(
+                    (got - want).abs() <= 1e-6 * want,
+                    "{got} vs π·L({t_k} K) = {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn frames_are_seeded_physical_and_labelled() {
+        let Some(r) = reference() else { return };
+        let opts = TestsetOptions {
+            kind: Kind::RealEarth,
+            count: 4,
+            seed: 5,
+            reference: r,
+            no_target_fraction: Some(0.5),
+            preview: false,
+            progress: false,
+        };
+        let bar = ProgressBar::hidden();
+        let a = make_frames(&opts, &bar).expect("frames");
+        let b = make_frames(&opts, &bar).expect("frames");
+        assert_eq!(a.len(), 4);
+        let none = a.iter().filter(|f| f.record.target == "none").count();
+        assert_eq!(none, 2);
+        for (fa, fb) in a.iter().zip(&b) {
+            assert_eq!(fa.frame, fb.frame, "{}: same seed, same DN", fa.record.file);
+            assert_eq!(fa.record, fb.record);
+            let [x0, y0, x1, y1] = fa.record.bbox;
+            let [q0, r0, q1, r1] = fa.record.bbox_quarter;
+            if fa.record.target == "none" {
+                assert_eq!([x0, y0, x1, y1, q0, r0, q1, r1], [0; 8]);
+            } else {
+                assert!(
+                    x0 < x1 && y0 < y1 && x1 <= 328 && y1 <= 248,
+                    "{:?}",
+                    fa.record.bbox
+                );
+                // The quarter box holds the half box.
+                assert!(q0 <= x0 && r0 <= y0 && q1 >= x1 && r1 >= y1);
+            }
+            let max = (1u32 << fa.frame.bits) - 1;
+            assert!(fa.frame.pixels.iter().all(|&v| u32::from(v) <= max));
+        }
+    }
+}
