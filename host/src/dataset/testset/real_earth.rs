@@ -277,6 +277,7 @@ mod tests {
         let earth = RealEarth::load(&r, (328, 248), &band).expect("load");
         // The source read independently, with the `image` crate.
         let img = image::open(r.join(EARTH_IMAGE)).expect("png").into_luma16();
+        println!("{} windows fully inside the data", earth.corners.len());
         assert!(earth.corners.len() > 100, "{} windows", earth.corners.len());
         for (k, flip) in [
             (0usize, 0u8),
