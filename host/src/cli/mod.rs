@@ -60,8 +60,9 @@ pub enum Command {
     Detect(detect::DetectArgs),
     /// Print the scratch memory of each detector, in bytes.
     Memory,
-    /// Write the procedural fixture frames as 16-bit PNG with a `truth.csv`; with
-    /// --count, a seeded family of that many frames (as `testset --kind fixtures`).
+    /// Write the procedural fixture frames as 16-bit PNG with a `truth.csv`.
+    ///
+    /// With --count, a seeded family of that many frames (as `testset --kind fixtures`).
     Fixtures {
         /// Output directory (created if missing).
         #[arg(long, default_value = "fixtures")]
@@ -133,11 +134,12 @@ pub enum Command {
     /// (8-200 km) and BT percentiles, beside a real longwave image (--real PNG, value =
     /// BT x 50); --preview writes ours and the real image side by side (220-300 K).
     EarthTexture(earth_texture::EarthTextureArgs),
-    /// Write a labelled test set to score detectors on (never to tune them): the
-    /// seeded procedural fixtures, the real Hayabusa2 TIR dark frame with and without
-    /// rendered targets, or rendered targets over windows of a real LWIR Earth image.
-    /// 16-bit PNG, truth.csv (as `render` writes, both truth conventions) and
-    /// metadata.jsonl; `tirroi eval --images DIR` scores it.
+    /// Write labelled test frames to score detectors on, never to tune them.
+    ///
+    /// Kinds: the seeded procedural fixtures, the real Hayabusa2 TIR dark frame with
+    /// and without rendered targets, or rendered targets over windows of a real LWIR
+    /// Earth image. 16-bit PNG, truth.csv (as `render` writes, both truth conventions)
+    /// and metadata.jsonl; `tirroi eval --images DIR` scores it. docs/testsets.md.
     Testset(testset::TestsetArgs),
 }
 
