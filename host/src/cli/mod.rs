@@ -15,6 +15,7 @@
 //! | `render` | [`render`] |
 //! | `merge` | [`merge`] |
 //! | `tune` | [`tune`] |
+//! | `testset` | [`testset`] |
 //!
 //! `--method` of `detect`, `eval` and `tune` is parsed in one place, [`methods`].
 
@@ -35,6 +36,7 @@ pub mod paper;
 pub mod render;
 pub mod sensor;
 pub mod sensor_fit;
+pub mod testset;
 pub mod tune;
 
 /// Exit code for bad input (files, sizes, parameters), as clap uses for bad arguments.
@@ -89,10 +91,18 @@ pub enum Command {
     /// is this output).
     Memory,
     /// Write the procedural fixture frames as 16-bit PNG with a `truth.csv`.
+    ///
+    /// With --count, a seeded family of that many frames (as `testset --kind fixtures`).
     Fixtures {
         /// Output directory (created if missing).
         #[arg(long, default_value = "fixtures")]
         out: PathBuf,
+        /// Frames of the seeded family (omitted: the four standard fixtures).
+        #[arg(long)]
+        count: Option<usize>,
+        /// Seed of the family (with --count).
+        #[arg(long, default_value_t = 16, requires = "count")]
+        seed: u64,
     },
     /// Run every detector on the built-in procedural frames and print IoU and time.
     Demo {
@@ -164,6 +174,13 @@ pub enum Command {
     /// (8-200 km) and BT percentiles, beside a real longwave image (--real PNG, value =
     /// BT x 50); --preview writes ours and the real image side by side (220-300 K).
     EarthTexture(earth_texture::EarthTextureArgs),
+    /// Write labelled test frames to score detectors on, never to tune them.
+    ///
+    /// Kinds: the seeded procedural fixtures, the real Hayabusa2 TIR dark frame with
+    /// and without rendered targets, or rendered targets over windows of a real LWIR
+    /// Earth image. 16-bit PNG, truth.csv (as `render` writes, both truth conventions)
+    /// and metadata.jsonl; `tirroi eval --images DIR` scores it. docs/testsets.md.
+    Testset(testset::TestsetArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -176,7 +193,7 @@ pub fn main() -> ExitCode {
         Command::Detect(args) => detect::run(&args),
         Command::Memory => memory::run(),
         Command::Demo { repeat, figures } => demo::run(repeat as usize, figures.as_deref()),
-        Command::Fixtures { out } => exit_code(fixtures::run(&out)),
+        Command::Fixtures { out, count, seed } => exit_code(fixtures::run(&out, count, seed)),
         Command::Sensor(args) => sensor::run(&args),
         Command::SensorFit(args) => exit_code(sensor_fit::run(&args)),
         Command::Eval(args) => exit_code(eval::run(&args)),
@@ -185,6 +202,7 @@ pub fn main() -> ExitCode {
         Command::Render(args) => exit_code(render::run(&args)),
         Command::Merge(args) => exit_code(merge::run(&args)),
         Command::EarthTexture(args) => exit_code(earth_texture::run(&args)),
+        Command::Testset(args) => exit_code(testset::run(&args)),
     }
 }
 

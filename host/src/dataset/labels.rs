@@ -8,15 +8,18 @@ use super::DatasetError;
 use super::images::{ImageRecord, atomic_write};
 use crate::world::scene::SceneFile;
 
+/// The header line of `truth.csv` (with its newline): the box, the group and metadata
+/// columns, the quarter-coverage box and the signal-to-clutter ratio
+/// ([`crate::dataset`] module docs). Test sets ([`crate::dataset::testset`]) write the same.
+pub const TRUTH_CSV_HEADER: &str = "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter\n";
+
 /// Writes `truth.csv`, `coco.json` and `metadata.jsonl` (each atomically).
 pub(super) fn write_labels<'a>(
     file: &SceneFile,
     dir: &Path,
     records: impl Iterator<Item = &'a ImageRecord>,
 ) -> Result<(), DatasetError> {
-    let mut csv = String::from(
-        "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter\n",
-    );
+    let mut csv = String::from(TRUTH_CSV_HEADER);
     let mut jsonl = String::new();
     let mut images = Vec::new();
     let mut annotations = Vec::new();

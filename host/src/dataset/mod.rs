@@ -42,8 +42,10 @@ mod library;
 mod manifest;
 mod merge;
 mod plan;
+pub mod testset;
 
 pub use images::ImageRecord;
+pub use labels::TRUTH_CSV_HEADER;
 pub use library::{Library, ThermalState};
 pub use manifest::{
     JOURNAL_FILE, LABEL_FILES, MANIFEST_FILE, MAX_SHARDS, Manifest, OutState, Outputs, RunSource,

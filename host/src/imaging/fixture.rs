@@ -30,7 +30,8 @@ pub struct FixtureSpec {
     /// Background kind.
     pub background: Background,
     /// Box of the target's body (the cube); a narrower cylinder is attached to its
-    /// right side, and the truth box covers both.
+    /// right side, and the truth box covers both. An empty box renders a frame
+    /// without a target (empty truth).
     pub body: Roi,
     /// Mean DN of the target's brightest face.
     pub target_dn: u16,
@@ -65,6 +66,20 @@ pub struct Fixture {
     pub frame: FrameBuf,
     /// Tight box of all target pixels.
     pub truth: Roi,
+}
+
+/// Deep space level, DN.
+pub const SPACE_DN: f64 = 300.0;
+
+/// The Earth's limb: a circle (centre x, centre y, radius), px, whose centre lies below
+/// the frame; pixels inside it see the Earth when the background is [`Background::Earth`].
+pub const EARTH_LIMB_PX: (f64, f64, f64) = (140.0, 900.0, 780.0);
+
+/// Whether pixel (x, y) lies on the Earth's disc ([`EARTH_LIMB_PX`]).
+pub fn on_earth_disc(x: usize, y: usize) -> bool {
+    let (cx, cy, r) = EARTH_LIMB_PX;
+    let (dx, dy) = (x as f64 - cx, y as f64 - cy);
+    (dx * dx + dy * dy).sqrt() < r
 }
 
 /// Smooth value noise in [0, 1): bilinear interpolation of a random lattice.
@@ -106,23 +121,30 @@ pub fn render(spec: &FixtureSpec) -> Fixture {
     // `Normal::new` only fails for a non-finite σ: such a spec renders without noise.
     let noise = Normal::new(0.0, spec.noise_dn.max(0.0)).ok();
     let max_dn = f64::from((1u32 << DEFAULT_BIT_DEPTH) - 1);
-    let space_dn = 300.0;
-    // Earth limb: a circle whose centre lies below the frame.
-    let (earth_cx, earth_cy, earth_r) = (140.0, 900.0, 780.0);
+    let space_dn = SPACE_DN;
 
-    let body = spec.body;
-    let cyl_h = (body.height() / 2).max(1);
-    let cyl = Roi::new(
-        body.x1,
-        body.y0 + (body.height() - cyl_h) / 2,
-        body.x1
-            .saturating_add(body.width() / 2)
-            .min(FRAME_WIDTH as u16),
-        body.y0 + (body.height() - cyl_h) / 2 + cyl_h,
-    );
-    let truth = body
-        .clip(FRAME_WIDTH as u16, FRAME_HEIGHT as u16)
-        .hull(&cyl);
+    let body = if spec.body.is_empty() {
+        Roi::EMPTY
+    } else {
+        spec.body
+    };
+    let (cyl, truth) = if body.is_empty() {
+        (Roi::EMPTY, Roi::EMPTY)
+    } else {
+        let cyl_h = (body.height() / 2).max(1);
+        let cyl = Roi::new(
+            body.x1,
+            body.y0 + (body.height() - cyl_h) / 2,
+            body.x1
+                .saturating_add(body.width() / 2)
+                .min(FRAME_WIDTH as u16),
+            body.y0 + (body.height() - cyl_h) / 2 + cyl_h,
+        );
+        let truth = body
+            .clip(FRAME_WIDTH as u16, FRAME_HEIGHT as u16)
+            .hull(&cyl);
+        (cyl, truth)
+    };
 
     let mut pixels = Vec::with_capacity(FRAME_WIDTH * FRAME_HEIGHT);
     for y in 0..FRAME_HEIGHT {
@@ -141,9 +163,7 @@ pub fn render(spec: &FixtureSpec) -> Fixture {
                 let t = (f64::from(yu - cyl.y0) + 0.5) / f64::from(cyl.height()) * 2.0 - 1.0;
                 spec.target_dn as f64 * (0.7 + 0.3 * (1.0 - t * t).sqrt())
             } else {
-                let (dx, dy) = (x as f64 - earth_cx, y as f64 - earth_cy);
-                let on_earth =
-                    spec.background == Background::Earth && (dx * dx + dy * dy).sqrt() < earth_r;
+                let on_earth = spec.background == Background::Earth && on_earth_disc(x, y);
                 if on_earth {
                     let t: f64 = octaves.iter().map(|(n, w)| w * n.at(x, y)).sum();
                     spec.earth_dn as f64 + (t - 0.5) * spec.texture_dn as f64

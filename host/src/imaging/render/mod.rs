@@ -364,6 +364,65 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     }
     stats.earth_ns = t1.elapsed().as_nanos() as u64;
 
+    let out = read_out(input, signal, pure.bounds(), &mut stats)?;
+
+    let truth = mask_box(&coverage, cam.w);
+    let truth_quarter = coverage_box(&coverage, cam.w, |c| c > QUARTER_COVERAGE);
+    Ok(Rendered {
+        width: cam.w,
+        height: cam.h,
+        dn: out.dn,
+        signal: out.signal,
+        coverage,
+        truth,
+        truth_quarter,
+        earth_fraction: earth_px as f64 / n as f64,
+        moon_px,
+        mapping: out.mapping,
+        noise_sigma_dn: out.noise_sigma_dn,
+        stats,
+        clutter: None,
+    })
+}
+
+/// A signal frame read out: what [`read_out`] returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReadOut {
+    /// DN, row-major.
+    pub dn: Vec<u16>,
+    /// The signal after the optics PSF and the sensor signature (as given without them).
+    pub signal: Vec<f32>,
+    /// The DN map used.
+    pub mapping: DnMapping,
+    /// Total noise σ, DN (0 without noise).
+    pub noise_sigma_dn: f32,
+}
+
+/// The readout stage of [`render`] on a signal frame of `input.camera`'s size (F in
+/// W m⁻² in radiometry, q_fc in detection): the optics PSF and sensor signature of
+/// `input.sensor`, the DN map of `input.readout` (auto range over `pure`, the
+/// (min, max) signal of the frame's unmixed pixels, or the fixed gain), the noise of
+/// `input.noise_seed` and quantisation. The scene part of `input` (target, Earth,
+/// Moon) is not used: callers that make the signal another way (test frames over real
+/// backgrounds) read it out exactly as a rendered frame is.
+///
+/// # Errors
+/// [`RenderError`] for a signal of another size than the camera's, a bad gain factor
+/// or values the core's camera model refuses.
+pub fn read_out(
+    input: &RenderInput<'_>,
+    mut signal: Vec<f32>,
+    pure: Option<(f64, f64)>,
+    stats: &mut RenderStats,
+) -> Result<ReadOut, RenderError> {
+    let (w, h) = (input.camera.width, input.camera.height);
+    let n = w * h;
+    if signal.len() != n {
+        return Err(RenderError::Input(format!(
+            "signal of {} px for a {w} × {h} camera: expected {n}",
+            signal.len()
+        )));
+    }
     // Radiance → this readout's signal unit: F = π·L, q_fc = L·ΔA_c/r² (face-on).
     let signal_per_radiance_sr = match input.readout {
         Readout::Radiometry => std::f64::consts::PI,
@@ -372,15 +431,15 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     let ts = Instant::now();
     if let Some(psf) = input.sensor.psf {
         let mut blurred = vec![0f32; n];
-        psf.apply(&signal, cam.w, &mut blurred)
+        psf.apply(&signal, w, &mut blurred)
             .map_err(RenderError::Input)?;
         signal = blurred;
     }
     if let Some(sig) = input.sensor.signature {
-        if sig.width != cam.w || sig.height != cam.h {
+        if sig.width != w || sig.height != h {
             return Err(RenderError::Input(format!(
                 "sensor signature of {} × {} px for a {} × {} camera: expected the camera's size",
-                sig.width, sig.height, cam.w, cam.h
+                sig.width, sig.height, w, h
             )));
         }
         sig.apply(&mut signal, signal_per_radiance_sr)
@@ -404,7 +463,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
             // Eq. 17 over the pure pixels, with the span kept at least
             // MIN_RANGE_NETD NETDs wide (in F at the reference temperature), so a
             // near-uniform scene is not stretched until its noise fills the frame.
-            let (lo, hi) = pure.bounds().unwrap_or((0.0, 0.0));
+            let (lo, hi) = pure.unwrap_or((0.0, 0.0));
             let min_span = MIN_RANGE_NETD
                 * input.camera.netd_k
                 * std::f64::consts::PI
@@ -458,31 +517,20 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
             Some(NoiseField::<Cap1024x768>::for_capacity(
                 sigmas,
                 input.camera.flicker_correlation_px,
-                cam.w,
+                w,
                 seed,
             )?)
         }
     };
     let mut dn = vec![0u16; n];
-    expose_frame(&signal, cam.w, &mapping, field.as_mut(), &mut dn)?;
+    expose_frame(&signal, w, &mapping, field.as_mut(), &mut dn)?;
     stats.expose_ns = t2.elapsed().as_nanos() as u64;
 
-    let truth = mask_box(&coverage, cam.w);
-    let truth_quarter = coverage_box(&coverage, cam.w, |c| c > QUARTER_COVERAGE);
-    Ok(Rendered {
-        width: cam.w,
-        height: cam.h,
+    Ok(ReadOut {
         dn,
         signal,
-        coverage,
-        truth,
-        truth_quarter,
-        earth_fraction: earth_px as f64 / n as f64,
-        moon_px,
         mapping,
         noise_sigma_dn,
-        stats,
-        clutter: None,
     })
 }
 
