@@ -39,10 +39,12 @@ use crate::world::scene::SceneFile;
 mod images;
 mod labels;
 mod library;
+mod memory;
 mod plan;
 
 pub use images::ImageRecord;
 pub use library::{Library, ThermalState};
+pub use memory::{FrameRenderer, LabelledFrame};
 pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
 use images::write_image;
