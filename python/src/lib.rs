@@ -271,7 +271,7 @@ fn auto_map(
     bits: u8,
 ) -> PyResult<DnMapping> {
     let (lo, hi) = range_k;
-    if !(lo < hi) {
+    if lo >= hi {
         return Err(bad(format!(
             "--range-k: T_lo = {lo} K is not below T_hi = {hi} K; expected two temperatures T_lo,T_hi in K with T_lo < T_hi, e.g. 150,460"
         )));
