@@ -16,7 +16,7 @@ import math
 import os
 import subprocess
 from pathlib import Path
-from typing import Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 import pytest
@@ -198,8 +198,9 @@ def test_detect_takes_other_integer_arrays() -> None:
     assert a == b == c
 
 
-def sensor(tirroi_bin: Path, *args: str) -> dict:
-    return json.loads(run(tirroi_bin, "sensor", "--json", *args).stdout)
+def sensor(tirroi_bin: Path, *args: str) -> Dict[str, Any]:
+    rep: Dict[str, Any] = json.loads(run(tirroi_bin, "sensor", "--json", *args).stdout)
+    return rep
 
 
 TEMPS = [150.0, 200.0, 250.0, 300.0, 350.0, 400.0, 460.0, 173.25, 1000.0]

@@ -58,7 +58,8 @@ __version__: str = _native.__version__
 Box = Tuple[int, int, int, int]
 """A box ``(x0, y0, x1, y1)`` in pixels: (x0, y0) inclusive, (x1, y1) exclusive."""
 
-ArrayLikeFloat = Union[float, Sequence[float], npt.NDArray[np.floating[Any]]]
+ArrayLikeFloat = Union[float, Sequence[float], npt.NDArray[Any]]
+"""Numbers: a float, a sequence of floats or a NumPy array of any real dtype."""
 
 NETD_K: float
 NETD_REFERENCE_K: float
