@@ -153,7 +153,7 @@ fn encode_png(
         .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))
 }
 
-fn record(
+pub(super) fn record(
     file: &SceneFile,
     plan: &ImagePlan,
     frame: &Rendered,

@@ -41,6 +41,7 @@ mod labels;
 mod library;
 mod manifest;
 mod merge;
+mod memory;
 mod plan;
 pub mod testset;
 
@@ -52,6 +53,7 @@ pub use manifest::{
     Shard, clear_run, inspect, quote, sha256_hex,
 };
 pub use merge::merge;
+pub use memory::{FrameRenderer, LabelledFrame};
 pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
 use images::write_image;
