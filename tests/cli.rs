@@ -49,20 +49,12 @@ fn parse_line(line: &str) -> (String, String, Option<[u16; 4]>) {
     let obj = v.as_object().expect("a JSON object per line");
     let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
     keys.sort_unstable();
-    assert_eq!(
-        keys,
-        ["bbox", "file", "method", "score", "time_us"],
-        "{line}"
-    );
+    assert_eq!(keys, ["bbox", "file", "method", "score", "time_us"], "{line}");
     let time = obj["time_us"].as_f64().expect("time_us is a number");
     assert!(time.is_finite() && time >= 0.0, "{line}");
     let score = obj["score"].as_f64().expect("score is a number");
     assert!((0.0..=1.0).contains(&score), "score in 0–1: {line}");
-    assert_eq!(
-        obj["bbox"].is_null(),
-        score == 0.0,
-        "score 0 exactly when no box: {line}"
-    );
+    assert_eq!(obj["bbox"].is_null(), score == 0.0, "score 0 exactly when no box: {line}");
     let bbox = match &obj["bbox"] {
         Value::Null => None,
         Value::Array(a) => {
