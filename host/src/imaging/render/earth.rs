@@ -59,7 +59,7 @@ impl EarthRays<'_> {
         if let Some(clouds) = self.view.map.clouds() {
             // A resolved surface: radiance × limb darkening, no cos of the emission
             // angle in the view factor (module docs of `render`).
-            let t = clouds.temperature_k(lat, lon, e) as f32;
+            let t = clouds.temperature_k(lat, lon) as f32;
             let radiance = self.lut.radiance_f32(t, 1.0)?;
             let mu = (-dot(normal, d)).clamp(0.0, 1.0);
             let g = mu.powf(LIMB_DARKENING_EXPONENT) * d[2].max(0.0)

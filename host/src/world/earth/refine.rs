@@ -80,8 +80,10 @@ impl EarthMap {
     /// This map with the sub-grid cloud texture `clouds` (built from the same grid):
     /// the renderer then takes every ray's temperature from it
     /// ([`CloudField::temperature_k`](super::CloudField::temperature_k)) instead of the
-    /// mesh cell.
+    /// mesh cell. Builds the whole texture now ([`CloudField::fill`](super::CloudField::fill),
+    /// in parallel), so rendering only reads it.
     pub fn with_clouds(mut self, clouds: super::CloudField) -> EarthMap {
+        clouds.fill();
         self.clouds = Some(Box::new(clouds));
         self
     }
