@@ -40,8 +40,8 @@ mod images;
 mod labels;
 mod library;
 mod manifest;
-mod merge;
 mod memory;
+mod merge;
 mod plan;
 pub mod testset;
 
@@ -52,8 +52,8 @@ pub use manifest::{
     JOURNAL_FILE, LABEL_FILES, MANIFEST_FILE, MAX_SHARDS, Manifest, OutState, Outputs, RunSource,
     Shard, clear_run, inspect, quote, sha256_hex,
 };
-pub use merge::merge;
 pub use memory::{FrameRenderer, LabelledFrame};
+pub use merge::merge;
 pub use plan::{EDGE_CUT_KEEP_PX, ImagePlan, MoonPlan, ThermalKey, keep_in_view, plan};
 
 use images::write_image;

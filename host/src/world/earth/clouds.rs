@@ -194,6 +194,10 @@ pub struct CloudField {
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
     tiles: Vec<OnceLock<Box<Tile>>>,
+    /// Every cell's scale s in one flat array, row-major, once [`CloudField::fill`] has
+    /// built them all: the border blend reads up to four neighbours' s per ray, and
+    /// this spares it the pointer chase into each neighbour's tile.
+    scales: OnceLock<Vec<f64>>,
 }
 
 impl Clone for CloudField {
@@ -208,6 +212,7 @@ impl Clone for CloudField {
             cells: self.cells.clone(),
             balance: self.balance.clone(),
             tiles: self.tiles.clone(),
+            scales: self.scales.clone(),
         }
     }
 }
@@ -311,6 +316,7 @@ impl CloudField {
             tiles: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
                 .collect(),
+            scales: OnceLock::new(),
         };
         // The noise's distribution on random directions (fixed stream: deterministic).
         let mut srng = Xoshiro128pp::seed_from_u64(0x5A3F_1E5D);
@@ -530,6 +536,14 @@ impl CloudField {
         (0..n).into_par_iter().for_each(|i| {
             let (r, c) = split(i);
             self.tile(r, c);
+        });
+        self.scales.get_or_init(|| {
+            (0..n)
+                .map(|i| {
+                    let (r, c) = split(i);
+                    self.tile(r, c).s
+                })
+                .collect()
         });
     }
 
@@ -752,6 +766,8 @@ impl CloudField {
                     let (r, c) = Self::neighbour(row, col, dr, dc);
                     s += w * if dr == 1 && dc == 1 {
                         tile.s
+                    } else if let Some(scales) = self.scales.get() {
+                        scales[r * OlrGrid::COLS + c]
                     } else {
                         self.tile(r, c).s
                     };
