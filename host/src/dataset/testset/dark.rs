@@ -231,13 +231,7 @@ mod tests {
     use crate::imaging::signature::FIXED_GAIN_PEDESTAL_DN;
 
     fn reference() -> Option<PathBuf> {
-        let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
-        if p.join(DARK_FRAME).is_file() {
-            Some(p)
-        } else {
-            println!("SKIPPED: no reference data at {}", p.display());
-            None
-        }
+        crate::dataset::testset::test_reference(DARK_FRAME)
     }
 
     #[test]

@@ -461,3 +461,16 @@ mod tests {
         );
     }
 }
+
+/// For tests: the repository's `../shared/reference` folder when it holds `file`;
+/// otherwise prints `SKIPPED` and gives `None` (the real data is not in every checkout).
+#[cfg(test)]
+pub(crate) fn test_reference(file: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
+    if p.join(file).is_file() {
+        Some(p)
+    } else {
+        println!("SKIPPED: no reference data at {}", p.display());
+        None
+    }
+}

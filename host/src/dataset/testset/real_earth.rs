@@ -261,13 +261,7 @@ mod tests {
     use crate::dataset::testset::{TestsetOptions, make_frames};
 
     fn reference() -> Option<PathBuf> {
-        let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
-        if p.join(EARTH_IMAGE).is_file() {
-            Some(p)
-        } else {
-            println!("SKIPPED: no reference data at {}", p.display());
-            None
-        }
+        crate::dataset::testset::test_reference(EARTH_IMAGE)
     }
 
     #[test]
