@@ -380,6 +380,19 @@ pub fn labels(frames: &[TestFrame]) -> Result<(String, String), DatasetError> {
     Ok((csv, jsonl))
 }
 
+/// For tests: the repository's `../shared/reference` folder when it holds `file`;
+/// otherwise prints `SKIPPED` and gives `None` (the real data is not in every checkout).
+#[cfg(test)]
+pub(crate) fn test_reference(file: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
+    if p.join(file).is_file() {
+        Some(p)
+    } else {
+        println!("SKIPPED: no reference data at {}", p.display());
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -459,18 +472,5 @@ mod tests {
             e.contains("dark_20180629_083003.fit") && e.contains("--reference"),
             "{e}"
         );
-    }
-}
-
-/// For tests: the repository's `../shared/reference` folder when it holds `file`;
-/// otherwise prints `SKIPPED` and gives `None` (the real data is not in every checkout).
-#[cfg(test)]
-pub(crate) fn test_reference(file: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference");
-    if p.join(file).is_file() {
-        Some(p)
-    } else {
-        println!("SKIPPED: no reference data at {}", p.display());
-        None
     }
 }
