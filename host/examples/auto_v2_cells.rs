@@ -7,7 +7,9 @@
 //! 0–255, i.e. the share of the cell covered by the target × 255).
 //!
 //! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
-//! `file,x0,y0,x1,y1,score` for `tirroi eval --predictions`.
+//! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
+//! --predictions`; `predict-all` the same with the confidence gate off (every winner
+//! boxed: the confidence model's training data).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -63,12 +65,15 @@ fn main() {
                 });
             } else {
                 let mut scratch = Box::new(AutoV2Scratch::new());
-                let d = AutoV2::default()
-                    .detect(&frame, &mut scratch)
-                    .expect("detect");
+                // `predict-all`: every winner (the confidence model's training data).
+                let gate_off = AutoV2 {
+                    min_score_permille: if mode == "predict-all" { 0 } else { 500 },
+                    ..AutoV2::default()
+                };
+                let d = gate_off.detect(&frame, &mut scratch).expect("detect");
                 match d.roi {
                     Some(r) => {
-                        let _ = writeln!(
+                        let _ = write!(
                             s,
                             "{file},{},{},{},{},{:.3}",
                             r.x0,
@@ -79,8 +84,25 @@ fn main() {
                         );
                     }
                     None => {
-                        let _ = writeln!(s, "{file},,,,,");
+                        let _ = write!(s, "{file},,,,,");
                     }
+                }
+                match scratch.work().winner() {
+                    Some(w) => {
+                        let _ = writeln!(
+                            s,
+                            ",{},{},{},{},{},{},{},{}",
+                            w.cells,
+                            w.box_w_cells,
+                            w.box_h_cells,
+                            w.sides,
+                            w.code_sum,
+                            w.code_max,
+                            w.components,
+                            w.runner_up_permille
+                        );
+                    }
+                    None => s.push_str(",,,,,,,,\n"),
                 }
             }
             s
@@ -93,7 +115,8 @@ fn main() {
         }
         h
     } else {
-        "file,x0,y0,x1,y1,score".to_string()
+        "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up"
+            .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");
 }

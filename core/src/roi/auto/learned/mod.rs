@@ -4,13 +4,16 @@
 //! against boxes of 8–64 px and their texture); the target cells are grouped into
 //! 8-connected components, the strongest (summed score) wins, and its cells gate
 //! `auto`'s full-resolution refinement (outermost boundaries, saturated targets).
-//! A box's confidence is the logistic of the winner's best cell score.
+//! A box's confidence is a logistic model over the winner's statistics (size, fill,
+//! sides touched, mean and best cell score, components, runner-up), fitted on our
+//! renders (`confidence_weights.rs`).
 //!
 //! Unlike `auto`'s "the outline is a step" rule, the region stage learns what the
 //! background looks like (cloud texture, the limb, a real camera's shading and hot
 //! pixels) from our renders, and a cloud edge touching the target is not part of it.
 
 mod cells;
+mod confidence_weights;
 pub mod features;
 pub mod forest;
 mod forest_trees;
@@ -50,6 +53,65 @@ impl Default for AutoV2 {
     }
 }
 
+/// What the region stage chose on the last frame (for the confidence model's
+/// training and for telemetry): `None` before any frame or without a component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Winner {
+    /// Target cells (8×8) of the winning component.
+    pub cells: u16,
+    /// Its cell box, cells.
+    pub box_w_cells: u8,
+    /// Its cell box, cells.
+    pub box_h_cells: u8,
+    /// Sides of the frame its cell box touches (0..=4).
+    pub sides: u8,
+    /// Summed class codes of its cells (quarter units of log-odds above the cell threshold).
+    pub code_sum: u32,
+    /// Its best cell's code.
+    pub code_max: u8,
+    /// Components found in the frame.
+    pub components: u16,
+    /// The runner-up's summed energy relative to the winner's, ‰ (0: no runner-up).
+    pub runner_up_permille: u16,
+}
+
+impl Winner {
+    /// The confidence model's integer features (`scripts/train-auto.py` computes the
+    /// same from the training dumps): log codes of the cells and of the cell box's
+    /// area, the box's fill ‰, sides touched, the mean code × 16, the best code, the
+    /// log code of the component count, the runner-up ‰.
+    pub fn confidence_features(&self) -> [i32; 8] {
+        let cells = u32::from(self.cells).max(1);
+        let area = u32::from(self.box_w_cells) * u32::from(self.box_h_cells);
+        [
+            features::log_code(cells - 1),
+            features::log_code(area.max(1) - 1),
+            (cells * 1000 / area.max(1)) as i32,
+            i32::from(self.sides),
+            (self.code_sum * 16 / cells) as i32,
+            i32::from(self.code_max),
+            features::log_code(u32::from(self.components)),
+            i32::from(self.runner_up_permille),
+        ]
+    }
+
+    /// Confidence that the winner's box is a hit, ‰: the logistic of the fitted
+    /// weights (`confidence_weights.rs`, 4096 per unit of log-odds) over
+    /// [`Self::confidence_features`].
+    pub fn score_permille(&self) -> u16 {
+        let z = self
+            .confidence_features()
+            .iter()
+            .zip(confidence_weights::WEIGHTS)
+            .fold(i64::from(confidence_weights::BIAS), |z, (&f, w)| {
+                z + i64::from(f) * i64::from(w)
+            });
+        // 4096 per unit of log-odds → score units (256 per unit).
+        let units = forest::SCORE_ONE as i64;
+        logistic_permille((z * units / 4096).clamp(-(1 << 20), 1 << 20) as i32)
+    }
+}
+
 /// `auto-v2`'s buffers (planes of 8×8 cells: `HalfCells`; of 4×4 cells: `Cells`).
 /// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate.
 #[derive(Debug, Clone)]
@@ -70,6 +132,14 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     row_sat: C::Column<u16>,
     hist: [u32; NOISE_BINS + 1],
     flag_row: C::Row<bool>,
+    winner: Option<Winner>,
+}
+
+impl<C: FrameCapacity> AutoV2Work<C> {
+    /// What the region stage chose on the last frame.
+    pub fn winner(&self) -> Option<Winner> {
+        self.winner
+    }
 }
 
 impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
@@ -90,6 +160,7 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         row_sat: ConstInit::INIT,
         hist: [0; NOISE_BINS + 1],
         flag_row: ConstInit::INIT,
+        winner: None,
     };
 }
 
@@ -248,9 +319,21 @@ impl AutoV2 {
             8,
             &mut work.comps,
         );
+        work.winner = None;
         let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
             return none;
         };
+        let (mut components, mut runner_up) = (0u16, 0u32);
+        for l in 1..next {
+            if work.comps.parent(l) != Some(l as u8) || l == usize::from(root) {
+                components += u16::from(work.comps.parent(l) == Some(l as u8));
+                continue;
+            }
+            components += 1;
+            if let Some(c) = work.comps.stats(l) {
+                runner_up = runner_up.max(c.energy);
+            }
+        }
         // The winner's best cell score is its confidence.
         let mut win_best = i32::MIN;
         {
@@ -263,8 +346,32 @@ impl AutoV2 {
                 }
             }
         }
-        let win_score = i32::from(self.cell_score) + (win_best - 1) * (forest::SCORE_ONE / 4);
-        let score_permille = logistic_permille(win_score);
+        let sides = u8::from(w8.x0 == 0)
+            + u8::from(w8.y0 == 0)
+            + u8::from(w8.x_end() >= plane8.0)
+            + u8::from(w8.y_end() >= plane8.1);
+        let mut code_sum = 0u32;
+        {
+            let labels8 = &work.labels8.as_ref()[..n8];
+            let codes = &work.labels4.as_ref()[..n8];
+            for (&l, &c) in labels8.iter().zip(codes) {
+                if l != 0 && work.comps.find(l) == root {
+                    code_sum += u32::from(c);
+                }
+            }
+        }
+        work.winner = Some(Winner {
+            cells: w8.area,
+            box_w_cells: w8.x_last - w8.x0 + 1,
+            box_h_cells: w8.y_last - w8.y0 + 1,
+            sides,
+            code_sum,
+            code_max: win_best.clamp(0, 255) as u8,
+            components,
+            runner_up_permille: (u64::from(runner_up) * 1000 / u64::from(w8.energy.max(1)))
+                .min(1000) as u16,
+        });
+        let score_permille = work.winner.map_or(0, |w| w.score_permille());
         if score_permille < self.min_score_permille {
             return none;
         }
@@ -546,6 +653,38 @@ mod tests {
             ..det
         };
         assert!(bad.detect(&frame, &mut scratch).is_err());
+    }
+
+    #[test]
+    fn confidence_is_the_logistic_of_the_weighted_features() {
+        for (cells, w, h, sides, comps, runner) in [
+            (1, 1, 1, 0, 1, 0),
+            (40, 8, 7, 1, 3, 200),
+            (600, 41, 31, 4, 90, 1000),
+        ] {
+            let win = Winner {
+                cells,
+                box_w_cells: w,
+                box_h_cells: h,
+                sides,
+                code_sum: u32::from(cells) * 9,
+                code_max: 20,
+                components: comps,
+                runner_up_permille: runner,
+            };
+            let f = win.confidence_features();
+            assert_eq!(f[0], log_code(u32::from(cells) - 1));
+            assert_eq!(f[4], 9 * 16);
+            let z: f64 = f
+                .iter()
+                .zip(confidence_weights::WEIGHTS)
+                .map(|(&f, w)| f64::from(f) * f64::from(w))
+                .sum::<f64>()
+                + f64::from(confidence_weights::BIAS);
+            let exact = 1000.0 / (1.0 + libm::exp(-z / 4096.0));
+            let got = f64::from(win.score_permille());
+            assert!((got - exact).abs() <= 6.0, "{got} vs {exact}");
+        }
     }
 
     #[test]
