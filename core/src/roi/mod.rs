@@ -191,6 +191,14 @@ pub struct Scratch<W, C: FrameCapacity = Reference> {
     pub(crate) roi: RoiBuilder<C>,
 }
 
+impl<W, C: FrameCapacity> Scratch<W, C> {
+    /// The detector's own buffers (read-only: what a detector exposes of its last
+    /// frame, e.g. `auto-v2`'s [`auto::learned::AutoV2Work::winner`]).
+    pub fn work(&self) -> &W {
+        &self.work
+    }
+}
+
 impl<W: ConstInit> Scratch<W> {
     /// Fresh scratch of the reference capacity, 328×248.
     pub const fn new() -> Self {

@@ -64,6 +64,7 @@
 
 mod decision;
 mod edges;
+pub mod learned;
 mod noise;
 mod refine;
 pub mod rules;

@@ -157,3 +157,18 @@ pub(super) fn noise_sigma(
         clean,
     }
 }
+
+/// Pixel noise σ in DN (≥ 1) of `win` from second differences only (blind to smooth
+/// shading and to the Earth's texture gradients; runs at 0 DN or saturated skipped),
+/// falling back to first differences when too few samples remain.
+pub(super) fn noise_sigma_second(
+    frame: &Frame<'_>,
+    win: Window,
+    hist: &mut [u32; NOISE_BINS + 1],
+    buf: &mut [u16],
+) -> u32 {
+    difference_sigma::<true>(frame, win, hist, buf)
+        .or_else(|| difference_sigma::<false>(frame, win, hist, buf))
+        .unwrap_or(1)
+        .max(1)
+}

@@ -1,0 +1,225 @@
+//! Per-cell features of the classifier: integers only, from the cell planes of
+//! [`super::cells`]. Every feature is scale-free (a ratio to the pixel noise σ, to
+//! the frame's range of cell means, or a share), so one model serves any gain, bit
+//! depth and readout.
+//!
+//! | index | feature |
+//! |---|---|
+//! | 0 | `(m − p50) · 256 / max(p98 − p2, σ)`: the cell's level within the frame's range |
+//! | 1 | `slog((m − p2) / σ)`: above the frame's dark end |
+//! | 2 | `slog((p98 − m) / σ)`: below the frame's bright end |
+//! | 3 | `log(step / σ)`: the cell's largest step over two pixels |
+//! | 4 | `slog((top − m) / σ)`: below the frame's top DN (saturation) |
+//! | 5 + 4k … 8 + 4k | for the boxes of radius `RADII_CELLS[k]` around the cell: `slog((m − mean)/σ)`, `(m − mean) · 16 / max(sd, σ)`, the share of edge cells × 256, `log(sd / σ)` |
+//!
+//! `m`: the cell's mean DN; `p2`, `p50`, `p98`: percentiles of the frame's cell
+//! means; `log(x)` = [`log_code`] of `4x` (16 codes per octave of quarter-σ units),
+//! `slog` its signed form; a box is cut to the plane (its mean and standard deviation
+//! `sd` over the cells inside).
+
+/// Features per cell.
+pub const FEATURES: usize = 5 + 4 * RADII_CELLS.len();
+
+/// Radii of the context boxes, cells (8, 16, 32, 64 px): from a far target's
+/// surroundings to a close target's whole extent.
+pub const RADII_CELLS: [usize; 4] = [1, 2, 4, 8];
+
+/// A cell is an edge cell (for the edge shares) when its largest step reaches this
+/// many σ: well above noise (a two-pixel difference of noise has σ√2, so 6 σ is over
+/// 4 of its σ).
+pub const EDGE_SIGMA: u32 = 6;
+
+/// Clamp of the normalised-contrast features (|value| ≤ 1024: 64 σ-of-the-box).
+const CONTRAST_CLAMP: i32 = 1024;
+
+/// `16 · log2(1 + v)` with the mantissa taken as linear between octaves (exact at
+/// powers of two, at most 16 · 0.0861 = 1.38 codes below, then floored: within 2.4
+/// codes; monotone, 0 at 0).
+pub fn log_code(v: u32) -> i32 {
+    let x = u64::from(v) + 1;
+    let l = 63 - x.leading_zeros();
+    let frac = ((x << 4) >> l) as i32 - 16;
+    (16 * l) as i32 + frac
+}
+
+/// [`log_code`] of `|d| · 4 / σ` with the sign of `d`.
+fn slog(d: i64, sigma: u32) -> i32 {
+    let q = (d.unsigned_abs() * 4 / u64::from(sigma.max(1))).min(u64::from(u32::MAX)) as u32;
+    if d < 0 { -log_code(q) } else { log_code(q) }
+}
+
+/// Integral planes for the box sums: inclusive prefix sums over the plane.
+pub struct Integrals<'a> {
+    /// Σ mean DN.
+    pub sum: &'a mut [u32],
+    /// Σ q², q = the cell's mean above p2, shifted right by [`FrameLevels::sd_shift`]
+    /// and clamped to [`SD_Q_MAX`] (fits `u32` for any plane of up to 1 325 cells).
+    pub sum_sq: &'a mut [u32],
+    /// Σ q.
+    pub sum_q: &'a mut [u32],
+    /// Σ edge cells.
+    pub edges: &'a mut [u16],
+}
+
+/// Largest q of the variance sums: 1 800² · 1 325 cells < 2³².
+pub const SD_Q_MAX: u32 = 1800;
+
+/// Builds the integral planes of `mean_dn` and of the edge cells (step codes of
+/// `step_code` at least the code of [`EDGE_SIGMA`]).
+pub fn integrate(
+    mean_dn: &[u16],
+    step_code: &[u8],
+    (pw, ph): (usize, usize),
+    lv: FrameLevels,
+    ints: &mut Integrals<'_>,
+) {
+    let edge_code = log_code(EDGE_SIGMA * 4);
+    for cy in 0..ph {
+        let (mut rs, mut rq, mut rq2, mut re) = (0u32, 0u32, 0u32, 0u16);
+        for cx in 0..pw {
+            let i = cy * pw + cx;
+            let m = u32::from(mean_dn[i]);
+            let q = (u32::from(mean_dn[i].saturating_sub(lv.p2)) >> lv.sd_shift).min(SD_Q_MAX);
+            rs += m;
+            rq += q;
+            rq2 += q * q;
+            re += u16::from(i32::from(step_code[i]) >= edge_code);
+            let (us, uq, uq2, ue) = if cy > 0 {
+                (
+                    ints.sum[i - pw],
+                    ints.sum_q[i - pw],
+                    ints.sum_sq[i - pw],
+                    ints.edges[i - pw],
+                )
+            } else {
+                (0, 0, 0, 0)
+            };
+            ints.sum[i] = rs + us;
+            ints.sum_q[i] = rq + uq;
+            ints.sum_sq[i] = rq2 + uq2;
+            ints.edges[i] = re + ue;
+        }
+    }
+}
+
+/// Box sums of the integral planes over cells `x0..=x1`, `y0..=y1`.
+fn box_sums(
+    ints: &Integrals<'_>,
+    pw: usize,
+    (x0, y0, x1, y1): (usize, usize, usize, usize),
+) -> (u64, u64, u64, u32) {
+    let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
+        (Some(x), Some(y)) => {
+            let i = y * pw + x;
+            (
+                u64::from(ints.sum[i]),
+                u64::from(ints.sum_q[i]),
+                u64::from(ints.sum_sq[i]),
+                u32::from(ints.edges[i]),
+            )
+        }
+        _ => (0, 0, 0, 0),
+    };
+    let (xa, ya) = (x0.checked_sub(1), y0.checked_sub(1));
+    let d = at(Some(x1), Some(y1));
+    let b = at(xa, Some(y1));
+    let c = at(Some(x1), ya);
+    let a = at(xa, ya);
+    (
+        d.0 + a.0 - b.0 - c.0,
+        d.1 + a.1 - b.1 - c.1,
+        d.2 + a.2 - b.2 - c.2,
+        d.3 + a.3 - b.3 - c.3,
+    )
+}
+
+/// Frame statistics the features refer to.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameLevels {
+    /// 2nd percentile of the cell means, DN.
+    pub p2: u16,
+    /// Median of the cell means, DN.
+    pub p50: u16,
+    /// 98th percentile of the cell means, DN.
+    pub p98: u16,
+    /// Pixel noise σ, DN (≥ 1).
+    pub sigma: u32,
+    /// Right shift of the variance sums' q: (p98 − p2) >> shift ≤ [`SD_Q_MAX`] / 2.
+    pub sd_shift: u32,
+    /// The frame's top DN.
+    pub max_dn: u16,
+}
+
+/// The `k`-th smallest of `values` (0-based), by bisection on the value: 16 counting
+/// passes, no copy.
+fn kth_smallest(values: &[u16], k: usize) -> u16 {
+    let (mut lo, mut hi) = (0u32, u32::from(u16::MAX));
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        let at_most = values.iter().filter(|&&v| u32::from(v) <= mid).count();
+        if at_most > k {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo as u16
+}
+
+/// The percentiles of `mean_dn`.
+pub fn levels(mean_dn: &[u16], sigma: u32, max_dn: u16) -> FrameLevels {
+    let n = mean_dn.len();
+    let at = |q: usize| kth_smallest(mean_dn, n.saturating_sub(1) * q / 100);
+    let (p2, p98) = (at(2), at(98));
+    let mut sd_shift = 0;
+    while (u32::from(p98.saturating_sub(p2)) >> sd_shift) > SD_Q_MAX / 2 {
+        sd_shift += 1;
+    }
+    FrameLevels {
+        p2,
+        p50: at(50),
+        p98,
+        sigma: sigma.max(1),
+        sd_shift,
+        max_dn,
+    }
+}
+
+/// The features of cell `(cx, cy)` into `out`.
+pub fn cell_features(
+    mean_dn: &[u16],
+    step_code: &[u8],
+    ints: &Integrals<'_>,
+    (pw, ph): (usize, usize),
+    lv: FrameLevels,
+    (cx, cy): (usize, usize),
+    out: &mut [i32; FEATURES],
+) {
+    let i = cy * pw + cx;
+    let m = i64::from(mean_dn[i]);
+    let s = lv.sigma;
+    let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(s));
+    out[0] = ((m - i64::from(lv.p50)) * 256 / range).clamp(-4096, 4096) as i32;
+    out[1] = slog(m - i64::from(lv.p2), s);
+    out[2] = slog(i64::from(lv.p98) - m, s);
+    out[3] = i32::from(step_code[i]);
+    out[4] = slog(i64::from(lv.max_dn) - m, s);
+    for (k, &r) in RADII_CELLS.iter().enumerate() {
+        let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
+        let (x1, y1) = ((cx + r).min(pw - 1), (cy + r).min(ph - 1));
+        let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as u64;
+        let (sum, sum_q, sum_sq, edges) = box_sums(ints, pw, (x0, y0, x1, y1));
+        let mean = (sum / n) as i64;
+        // Variance of q in 1/n² units: (n Σq² − (Σq)²) / n².
+        let var_n2 = (n * sum_sq).saturating_sub(sum_q * sum_q);
+        let sd = ((var_n2.isqrt() / n) << lv.sd_shift) as i64;
+        let d = m - mean;
+        let o = 5 + 4 * k;
+        out[o] = slog(d, s);
+        out[o + 1] = (d * 16 / sd.max(i64::from(s)))
+            .clamp(-i64::from(CONTRAST_CLAMP), i64::from(CONTRAST_CLAMP))
+            as i32;
+        out[o + 2] = (u64::from(edges) * 256 / n) as i32;
+        out[o + 3] = log_code((sd as u64 * 4 / u64::from(s)).min(u64::from(u32::MAX)) as u32);
+    }
+}

@@ -1,0 +1,702 @@
+//! `auto-v2`: `auto` with a learned region stage. Each 8×8-pixel cell is classified
+//! target or background by a forest of boosted trees over scale-free features of the
+//! cell and its surroundings ([`features`]: level within the frame, steps, contrast
+//! against boxes of 8–64 px and their texture); the target cells are grouped into
+//! 8-connected components, the strongest (summed score) wins, and its cells gate
+//! `auto`'s full-resolution refinement (outermost boundaries, saturated targets).
+//! A box's confidence is a logistic model over the winner's statistics (size, fill,
+//! sides touched, mean and best cell score, components, runner-up), fitted on our
+//! renders (`confidence_weights.rs`).
+//!
+//! Unlike `auto`'s "the outline is a step" rule, the region stage learns what the
+//! background looks like (cloud texture, the limb, a real camera's shading and hot
+//! pixels) from our renders, and a cloud edge touching the target is not part of it.
+
+mod cells;
+mod confidence_weights;
+pub mod features;
+pub mod forest;
+mod forest_trees;
+
+use super::super::plane::Window;
+use super::super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
+use super::decision::choose_target;
+use super::edges::{CellStats, EdgeComponents, label_edge_cells};
+use super::noise::{NOISE_BINS, noise_sigma_second};
+use super::refine::{Region, build_gate, count_saturation, outline};
+use super::rules::{MIN_SATURATED_PX, SATURATED_TAU_FACTOR};
+use crate::capacity::{ConstInit, FrameCapacity, Reference};
+use crate::frame::Frame;
+use cells::{CellPlanes, cell_plane, fill_cells};
+use features::{FEATURES, FrameLevels, Integrals, cell_features, integrate, levels};
+
+/// Parameters of `auto-v2`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AutoV2 {
+    /// Full-resolution boundary threshold, multiples of σ: 1..=1000. Default 8 (as `auto`).
+    pub fine_sigma: u16,
+    /// A cell is a target cell when its score reaches this, score units
+    /// ([`forest::SCORE_ONE`] per unit of log-odds): -4096..=4096. Default 0 (even odds).
+    pub cell_score: i16,
+    /// Boxes whose confidence is below this are dropped (no target), ‰: 0..=1000.
+    /// Default 500.
+    pub min_score_permille: u16,
+}
+
+impl Default for AutoV2 {
+    fn default() -> Self {
+        AutoV2 {
+            fine_sigma: 8,
+            cell_score: 0,
+            min_score_permille: 500,
+        }
+    }
+}
+
+/// What the region stage chose on the last frame (for the confidence model's
+/// training and for telemetry): `None` before any frame or without a component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Winner {
+    /// Target cells (8×8) of the winning component.
+    pub cells: u16,
+    /// Its cell box, cells.
+    pub box_w_cells: u8,
+    /// Its cell box, cells.
+    pub box_h_cells: u8,
+    /// Sides of the frame its cell box touches (0..=4).
+    pub sides: u8,
+    /// Summed class codes of its cells (quarter units of log-odds above the cell threshold).
+    pub code_sum: u32,
+    /// Its best cell's code.
+    pub code_max: u8,
+    /// Components found in the frame.
+    pub components: u16,
+    /// The runner-up's summed energy relative to the winner's, ‰ (0: no runner-up).
+    pub runner_up_permille: u16,
+}
+
+impl Winner {
+    /// The confidence model's integer features (`scripts/train-auto.py` computes the
+    /// same from the training dumps): log codes of the cells and of the cell box's
+    /// area, the box's fill ‰, sides touched, the mean code × 16, the best code, the
+    /// log code of the component count, the runner-up ‰.
+    pub fn confidence_features(&self) -> [i32; 8] {
+        let cells = u32::from(self.cells).max(1);
+        let area = u32::from(self.box_w_cells) * u32::from(self.box_h_cells);
+        [
+            features::log_code(cells - 1),
+            features::log_code(area.max(1) - 1),
+            (cells * 1000 / area.max(1)) as i32,
+            i32::from(self.sides),
+            (self.code_sum * 16 / cells) as i32,
+            i32::from(self.code_max),
+            features::log_code(u32::from(self.components)),
+            i32::from(self.runner_up_permille),
+        ]
+    }
+
+    /// Confidence that the winner's box is a hit, ‰: the logistic of the fitted
+    /// weights (`confidence_weights.rs`, 4096 per unit of log-odds) over
+    /// [`Self::confidence_features`].
+    pub fn score_permille(&self) -> u16 {
+        let z = self
+            .confidence_features()
+            .iter()
+            .zip(confidence_weights::WEIGHTS)
+            .fold(i64::from(confidence_weights::BIAS), |z, (&f, w)| {
+                z + i64::from(f) * i64::from(w)
+            });
+        // 4096 per unit of log-odds → score units (256 per unit).
+        let units = forest::SCORE_ONE as i64;
+        logistic_permille((z * units / 4096).clamp(-(1 << 20), 1 << 20) as i32)
+    }
+}
+
+/// `auto-v2`'s buffers (planes of 8×8 cells: `HalfCells`; of 4×4 cells: `Cells`).
+/// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate.
+#[derive(Debug, Clone)]
+pub struct AutoV2Work<C: FrameCapacity = Reference> {
+    mean_dn: C::HalfCells<u16>,
+    step_code: C::HalfCells<u8>,
+    sum: C::HalfCells<u32>,
+    sum_sq: C::HalfCells<u32>,
+    sum_q: C::HalfCells<u32>,
+    edges: C::HalfCells<u16>,
+    labels8: C::HalfCells<u8>,
+    labels4: C::Cells<u8>,
+    dilated4: C::Cells<u8>,
+    comps: EdgeComponents,
+    cell_sums: C::CellRow<u32>,
+    pixel_row: C::Row<u16>,
+    col_sat: C::Row<u16>,
+    row_sat: C::Column<u16>,
+    hist: [u32; NOISE_BINS + 1],
+    flag_row: C::Row<bool>,
+    winner: Option<Winner>,
+}
+
+impl<C: FrameCapacity> AutoV2Work<C> {
+    /// What the region stage chose on the last frame.
+    pub fn winner(&self) -> Option<Winner> {
+        self.winner
+    }
+}
+
+impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
+    const INIT: Self = AutoV2Work {
+        mean_dn: ConstInit::INIT,
+        step_code: ConstInit::INIT,
+        sum: ConstInit::INIT,
+        sum_sq: ConstInit::INIT,
+        sum_q: ConstInit::INIT,
+        edges: ConstInit::INIT,
+        labels8: ConstInit::INIT,
+        labels4: ConstInit::INIT,
+        dilated4: ConstInit::INIT,
+        comps: ConstInit::INIT,
+        cell_sums: ConstInit::INIT,
+        pixel_row: ConstInit::INIT,
+        col_sat: ConstInit::INIT,
+        row_sat: ConstInit::INIT,
+        hist: [0; NOISE_BINS + 1],
+        flag_row: ConstInit::INIT,
+        winner: None,
+    };
+}
+
+/// `auto-v2`'s scratch memory at capacity `C`.
+pub type AutoV2Scratch<C = Reference> = Scratch<AutoV2Work<C>, C>;
+
+/// Bytes of [`AutoV2Scratch`] at 328×248 (budget 48 KiB, checked at compile time).
+pub const SCRATCH_BYTES: usize = core::mem::size_of::<AutoV2Scratch>();
+const _: () = assert!(
+    SCRATCH_BYTES <= 48 * 1024,
+    "auto-v2's scratch exceeds 48 KiB"
+);
+
+/// Calls `f(cx, cy, features)` for every 8×8 cell of `frame` (training data for the
+/// classifier; the same code the detector runs). Returns the noise σ used, DN.
+pub fn for_each_cell_features<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    mut f: impl FnMut(usize, usize, &[i32; FEATURES]),
+) -> u32 {
+    let win = Window::full(frame);
+    let (plane, lv) = prepare(frame, work, win);
+    let ints = Integrals {
+        sum: work.sum.as_mut(),
+        sum_sq: work.sum_sq.as_mut(),
+        sum_q: work.sum_q.as_mut(),
+        edges: work.edges.as_mut(),
+    };
+    let mut feats = [0i32; FEATURES];
+    for cy in 0..plane.1 {
+        for cx in 0..plane.0 {
+            cell_features(
+                work.mean_dn.as_ref(),
+                work.step_code.as_ref(),
+                &ints,
+                plane,
+                lv,
+                (cx, cy),
+                &mut feats,
+            );
+            f(cx, cy, &feats);
+        }
+    }
+    lv.sigma
+}
+
+/// Stages 1–2: noise, cell planes, levels, integrals.
+fn prepare<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    win: Window,
+) -> ((usize, usize), FrameLevels) {
+    let plane = cell_plane(win);
+    let n = plane.0 * plane.1;
+    let sigma = noise_sigma_second(frame, win, &mut work.hist, work.pixel_row.as_mut());
+    fill_cells(
+        frame,
+        win,
+        sigma,
+        CellPlanes {
+            mean_dn: &mut work.mean_dn.as_mut()[..n],
+            step_code: &mut work.step_code.as_mut()[..n],
+        },
+        work.cell_sums.as_mut(),
+        work.col_sat.as_mut(),
+    );
+    let lv = levels(&work.mean_dn.as_ref()[..n], sigma, frame.max_dn());
+    integrate(
+        &work.mean_dn.as_ref()[..n],
+        &work.step_code.as_ref()[..n],
+        plane,
+        lv,
+        &mut Integrals {
+            sum: work.sum.as_mut(),
+            sum_sq: work.sum_sq.as_mut(),
+            sum_q: work.sum_q.as_mut(),
+            edges: work.edges.as_mut(),
+        },
+    );
+    (plane, lv)
+}
+
+/// Logistic of a score (score units) in ‰, integer: a 33-point table of the logistic
+/// over −8…8 log-odds, linear between.
+fn logistic_permille(score: i32) -> u16 {
+    const TABLE: [u16; 33] = [
+        0, 1, 1, 2, 2, 4, 7, 11, 18, 29, 47, 76, 119, 182, 269, 378, 500, 622, 731, 818, 881, 924,
+        953, 971, 982, 989, 993, 996, 998, 998, 999, 999, 1000,
+    ];
+    // Half a unit of log-odds per table step.
+    let half = forest::SCORE_ONE / 2;
+    let x = score.clamp(-16 * half, 16 * half) + 16 * half;
+    let i = (x / half) as usize;
+    let frac = x % half;
+    let a = i32::from(TABLE[i.min(32)]);
+    let b = i32::from(TABLE[(i + 1).min(32)]);
+    (a + (b - a) * frac / half) as u16
+}
+
+impl AutoV2 {
+    fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
+        let none = Detection {
+            roi: None,
+            threshold: 0,
+            foreground_px: 0,
+            score_permille: 0,
+        };
+        let win = Window::full(frame);
+        let (plane8, lv) = prepare(frame, work, win);
+        let n8 = plane8.0 * plane8.1;
+        // Stage 3: classify the cells; codes 1..=255 for target cells (the score
+        // above the cell threshold, in quarter units of log-odds), 0 otherwise.
+        let mut best_cell = i32::MIN;
+        {
+            let ints = Integrals {
+                sum: work.sum.as_mut(),
+                sum_sq: work.sum_sq.as_mut(),
+                sum_q: work.sum_q.as_mut(),
+                edges: work.edges.as_mut(),
+            };
+            let mut feats = [0i32; FEATURES];
+            let codes = &mut work.labels4.as_mut()[..n8];
+            for cy in 0..plane8.1 {
+                for cx in 0..plane8.0 {
+                    cell_features(
+                        work.mean_dn.as_ref(),
+                        work.step_code.as_ref(),
+                        &ints,
+                        plane8,
+                        lv,
+                        (cx, cy),
+                        &mut feats,
+                    );
+                    let s = forest::score(
+                        &forest_trees::NODES,
+                        &forest_trees::ROOTS,
+                        forest_trees::BIAS,
+                        &feats,
+                    );
+                    let above = s - i32::from(self.cell_score);
+                    codes[cy * plane8.0 + cx] = if above >= 0 {
+                        (1 + above / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8
+                    } else {
+                        0
+                    };
+                    best_cell = best_cell.max(s);
+                }
+            }
+        }
+        // Stage 4: components of target cells; the strongest wins.
+        let next = label_edge_cells(
+            &work.labels4.as_ref()[..n8],
+            &mut work.labels8.as_mut()[..n8],
+            plane8.0,
+            1,
+            8,
+            &mut work.comps,
+        );
+        work.winner = None;
+        let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
+            return none;
+        };
+        let (mut components, mut runner_up) = (0u16, 0u32);
+        for l in 1..next {
+            if work.comps.parent(l) != Some(l as u8) || l == usize::from(root) {
+                components += u16::from(work.comps.parent(l) == Some(l as u8));
+                continue;
+            }
+            components += 1;
+            if let Some(c) = work.comps.stats(l) {
+                runner_up = runner_up.max(c.energy);
+            }
+        }
+        // The winner's best cell score is its confidence.
+        let mut win_best = i32::MIN;
+        {
+            let parent_of = |comps: &mut EdgeComponents, l: u8| comps.find(l);
+            let labels8 = &work.labels8.as_ref()[..n8];
+            let codes = &work.labels4.as_ref()[..n8];
+            for (&l, &c) in labels8.iter().zip(codes) {
+                if l != 0 && parent_of(&mut work.comps, l) == root {
+                    win_best = win_best.max(i32::from(c));
+                }
+            }
+        }
+        let sides = u8::from(w8.x0 == 0)
+            + u8::from(w8.y0 == 0)
+            + u8::from(w8.x_end() >= plane8.0)
+            + u8::from(w8.y_end() >= plane8.1);
+        let mut code_sum = 0u32;
+        {
+            let labels8 = &work.labels8.as_ref()[..n8];
+            let codes = &work.labels4.as_ref()[..n8];
+            for (&l, &c) in labels8.iter().zip(codes) {
+                if l != 0 && work.comps.find(l) == root {
+                    code_sum += u32::from(c);
+                }
+            }
+        }
+        work.winner = Some(Winner {
+            cells: w8.area,
+            box_w_cells: w8.x_last - w8.x0 + 1,
+            box_h_cells: w8.y_last - w8.y0 + 1,
+            sides,
+            code_sum,
+            code_max: win_best.clamp(0, 255) as u8,
+            components,
+            runner_up_permille: (u64::from(runner_up) * 1000 / u64::from(w8.energy.max(1)))
+                .min(1000) as u16,
+        });
+        let score_permille = work.winner.map_or(0, |w| w.score_permille());
+        if score_permille < self.min_score_permille {
+            return none;
+        }
+        // Stage 5: the 4×4 gate plane from the 8×8 labels, then `auto`'s refinement.
+        let plane4 = (win.w.div_ceil(4), win.h.div_ceil(4));
+        let n4 = plane4.0 * plane4.1;
+        {
+            let labels4 = &mut work.labels4.as_mut()[..n4];
+            let labels8 = &work.labels8.as_ref()[..n8];
+            for (cy, row) in labels4.chunks_exact_mut(plane4.0).enumerate() {
+                for (cx, l) in row.iter_mut().enumerate() {
+                    *l = labels8[(cy / 2) * plane8.0 + cx / 2];
+                }
+            }
+        }
+        let last = |c: u8, n: usize| ((usize::from(c) * 2 + 1).min(n - 1)) as u8;
+        let w4 = CellStats {
+            x0: w8.x0.saturating_mul(2),
+            y0: w8.y0.saturating_mul(2),
+            x_last: last(w8.x_last, plane4.0),
+            y_last: last(w8.y_last, plane4.1),
+            ..w8
+        };
+        let region = Region::around(&w4, win);
+        let gate = build_gate(
+            &mut work.labels4.as_mut()[..n4],
+            &mut work.dilated4.as_mut()[..n4],
+            work.flag_row.as_mut(),
+            &mut work.comps,
+            root,
+            next,
+            &region,
+            win,
+            plane4,
+        );
+        let max_dn = frame.max_dn();
+        let near_sat = max_dn.saturating_sub((4 * lv.sigma).min(u32::from(u16::MAX)) as u16);
+        let counts = count_saturation::<C>(
+            frame,
+            &gate,
+            &region,
+            near_sat,
+            &mut work.col_sat.as_mut()[region.rx0..region.rx1],
+            &mut work.row_sat.as_mut()[region.ry0..region.ry1],
+        );
+        let saturated = counts.sat_px >= MIN_SATURATED_PX
+            && 8u32.saturating_mul(counts.near_px) < counts.sat_px;
+        let _ = SATURATED_TAU_FACTOR;
+        let tau = (u32::from(self.fine_sigma) * lv.sigma).min(u32::from(u16::MAX)) as u16;
+        let noise = super::noise::Noise {
+            sigma: lv.sigma,
+            clean: false,
+        };
+        let (roi, edge_px) = outline(frame, &gate, &region, noise, tau, saturated, &counts);
+        // Without a boundary inside the gate, the winner's cells are the box.
+        let roi = roi.or_else(|| {
+            let (fw, fh) = (frame.width(), frame.height());
+            let px = |c: usize, lim: usize| (c * 8).min(lim) as u16;
+            Some(Roi {
+                x0: px(usize::from(w8.x0), fw),
+                y0: px(usize::from(w8.y0), fh),
+                x1: px(usize::from(w8.x_last) + 1, fw),
+                y1: px(usize::from(w8.y_last) + 1, fh),
+            })
+        });
+        Detection {
+            roi,
+            threshold: tau.into(),
+            foreground_px: edge_px,
+            score_permille,
+        }
+    }
+}
+
+impl core::fmt::Display for AutoV2 {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "fine_sigma={} cell_score={} min_score_permille={}",
+            self.fine_sigma, self.cell_score, self.min_score_permille
+        )
+    }
+}
+
+impl Detector for AutoV2 {
+    type Work<C: FrameCapacity> = AutoV2Work<C>;
+    const NAME: &'static str = "auto-v2";
+
+    fn validate(&self) -> Result<(), DetectError> {
+        if !(1..=1000).contains(&self.fine_sigma) {
+            return Err(DetectError::InvalidParameter {
+                name: "fine_sigma",
+                expected: "1..=1000 (multiples of the pixel noise σ)",
+            });
+        }
+        if !(-4096..=4096).contains(&self.cell_score) {
+            return Err(DetectError::InvalidParameter {
+                name: "cell_score",
+                expected: "-4096..=4096 (score units, 256 per unit of log-odds)",
+            });
+        }
+        if self.min_score_permille > 1000 {
+            return Err(DetectError::InvalidParameter {
+                name: "min_score_permille",
+                expected: "0..=1000",
+            });
+        }
+        Ok(())
+    }
+
+    fn box_rule(&self) -> BoxRule {
+        BoxRule::LargestComponent
+    }
+
+    fn foreground<C: FrameCapacity, F: FnMut(usize, &[bool])>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        mut sink: F,
+    ) -> u32 {
+        let d = self.run(frame, work);
+        let roi = d.roi.unwrap_or(Roi::EMPTY);
+        let mask_row = &mut work.flag_row.as_mut()[..frame.width()];
+        for y in 0..frame.height() {
+            mask_row.fill(false);
+            if roi.contains(roi.x0, y as u16) {
+                mask_row[usize::from(roi.x0)..usize::from(roi.x1)].fill(true);
+            }
+            sink(y, mask_row);
+        }
+        d.threshold
+    }
+
+    fn detect<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        scratch: &mut Scratch<AutoV2Work<C>, C>,
+    ) -> Result<Detection, DetectError> {
+        self.validate()?;
+        DetectError::check_capacity::<C>(frame)?;
+        Ok(self.run(frame, &mut scratch.work))
+    }
+}
+#[cfg(test)]
+mod tests {
+    use super::features::{FEATURES, log_code};
+    use super::*;
+    use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+
+    /// A deterministic pseudo-random frame: texture, a bright block, hot pixels.
+    fn frame_pixels(seed: u32, bits: u8) -> std::vec::Vec<u16> {
+        let mut s = seed.wrapping_mul(2_654_435_761) | 1;
+        let top = (1u32 << bits) - 1;
+        (0..FRAME_WIDTH * FRAME_HEIGHT)
+            .map(|i| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                let (x, y) = (i % FRAME_WIDTH, i / FRAME_HEIGHT.max(1));
+                let base = (top / 4) + (s % 64) + ((x / 16 + y / 16) as u32 % 3) * 40;
+                let target = if (100..140).contains(&x) && (60..90).contains(&(i / FRAME_WIDTH)) {
+                    top / 3
+                } else {
+                    0
+                };
+                let hot = if s % 5000 == 0 { top } else { 0 };
+                (base + target).max(hot).min(top) as u16
+            })
+            .collect()
+    }
+
+    extern crate std;
+
+    #[test]
+    fn log_code_is_sixteen_log2() {
+        let mut last = -1;
+        for v in 0..100_000u32 {
+            let c = log_code(v);
+            assert!(c >= last, "monotone at {v}");
+            last = c;
+            let exact = 16.0 * libm::log2(f64::from(v) + 1.0);
+            // log2(1 + f) − f ≤ 0.0861 (at f = 0.4427): 1.38 codes, plus the floor.
+            assert!(
+                f64::from(c) <= exact + 1e-9 && exact - f64::from(c) < 2.4,
+                "{v}: {c} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn percentiles_equal_a_sort() {
+        let px = frame_pixels(7, 14);
+        let vals: std::vec::Vec<u16> = px.iter().step_by(61).copied().take(1271).collect();
+        let mut sorted = vals.clone();
+        sorted.sort_unstable();
+        let lv = features::levels(&vals, 3, 16383);
+        let n = vals.len() - 1;
+        assert_eq!(lv.p2, sorted[n * 2 / 100]);
+        assert_eq!(lv.p50, sorted[n * 50 / 100]);
+        assert_eq!(lv.p98, sorted[n * 98 / 100]);
+    }
+
+    #[test]
+    fn box_features_equal_brute_force() {
+        let px = frame_pixels(11, 14);
+        let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 14).unwrap();
+        let mut work: std::boxed::Box<AutoV2Work> = std::boxed::Box::new(ConstInit::INIT);
+        let mut got = std::vec::Vec::new();
+        let sigma = for_each_cell_features(&frame, &mut work, |cx, cy, f| got.push((cx, cy, *f)));
+        let (pw, ph) = (41, 31);
+        assert_eq!(got.len(), pw * ph);
+        // Brute force: cell means from the pixels, box means over the cut boxes.
+        let mean = |cx: usize, cy: usize| {
+            let (mut s, mut n) = (0u64, 0u64);
+            for y in cy * 8..(cy * 8 + 8).min(FRAME_HEIGHT) {
+                for x in cx * 8..(cx * 8 + 8).min(FRAME_WIDTH) {
+                    s += u64::from(px[y * FRAME_WIDTH + x]);
+                    n += 1;
+                }
+            }
+            (s / n) as i64
+        };
+        for &(cx, cy, f) in got.iter().step_by(37) {
+            let m = mean(cx, cy);
+            for (k, &r) in features::RADII_CELLS.iter().enumerate() {
+                let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
+                let (x1, y1) = ((cx + r).min(pw - 1), (cy + r).min(ph - 1));
+                let (mut s, mut n) = (0i64, 0i64);
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        s += mean(x, y);
+                        n += 1;
+                    }
+                }
+                let d = m - s / n;
+                let q = (d.unsigned_abs() * 4 / u64::from(sigma)) as u32;
+                let want = if d < 0 { -log_code(q) } else { log_code(q) };
+                assert_eq!(f[5 + 4 * k], want, "cell ({cx}, {cy}) radius {r}");
+            }
+            assert!(f.iter().all(|v| v.abs() <= 1 << 16));
+            assert_eq!(f.len(), FEATURES);
+        }
+    }
+
+    #[test]
+    fn detections_are_bounded_and_repeatable() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        for (seed, bits) in [(1, 12), (2, 14), (3, 16), (4, 8)] {
+            let px = frame_pixels(seed, bits);
+            for pixels in [
+                px.clone(),
+                std::vec![0u16; px.len()],
+                std::vec![((1u32 << bits) - 1) as u16; px.len()],
+            ] {
+                let frame = Frame::new(&pixels, FRAME_WIDTH, FRAME_HEIGHT, bits).unwrap();
+                let a = det.detect(&frame, &mut scratch).unwrap();
+                let b = det.detect(&frame, &mut scratch).unwrap();
+                assert_eq!(a, b, "same answer twice");
+                assert!(a.score_permille <= 1000);
+                match a.roi {
+                    Some(r) => {
+                        assert!(a.score_permille >= det.min_score_permille);
+                        assert!(r.x0 < r.x1 && r.y0 < r.y1);
+                        assert!(
+                            usize::from(r.x1) <= FRAME_WIDTH && usize::from(r.y1) <= FRAME_HEIGHT
+                        );
+                    }
+                    None => assert_eq!(a.score_permille, 0),
+                }
+            }
+        }
+        // A tiny frame and a bad parameter.
+        let small = [5u16; 3 * 2];
+        let frame = Frame::new(&small, 3, 2, 14).unwrap();
+        assert!(det.detect(&frame, &mut scratch).is_ok());
+        let bad = AutoV2 {
+            min_score_permille: 1001,
+            ..det
+        };
+        assert!(bad.detect(&frame, &mut scratch).is_err());
+    }
+
+    #[test]
+    fn confidence_is_the_logistic_of_the_weighted_features() {
+        for (cells, w, h, sides, comps, runner) in [
+            (1, 1, 1, 0, 1, 0),
+            (40, 8, 7, 1, 3, 200),
+            (600, 41, 31, 4, 90, 1000),
+        ] {
+            let win = Winner {
+                cells,
+                box_w_cells: w,
+                box_h_cells: h,
+                sides,
+                code_sum: u32::from(cells) * 9,
+                code_max: 20,
+                components: comps,
+                runner_up_permille: runner,
+            };
+            let f = win.confidence_features();
+            assert_eq!(f[0], log_code(u32::from(cells) - 1));
+            assert_eq!(f[4], 9 * 16);
+            let z: f64 = f
+                .iter()
+                .zip(confidence_weights::WEIGHTS)
+                .map(|(&f, w)| f64::from(f) * f64::from(w))
+                .sum::<f64>()
+                + f64::from(confidence_weights::BIAS);
+            let exact = 1000.0 / (1.0 + libm::exp(-z / 4096.0));
+            let got = f64::from(win.score_permille());
+            assert!((got - exact).abs() <= 6.0, "{got} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn logistic_table_is_monotone_and_centred() {
+        assert_eq!(logistic_permille(0), 500);
+        let mut last = 0;
+        for s in -5000..5000 {
+            let p = logistic_permille(s);
+            assert!(p >= last && p <= 1000);
+            last = p;
+            let exact = 1000.0 / (1.0 + libm::exp(-f64::from(s) / 256.0));
+            assert!((f64::from(p) - exact).abs() <= 6.0, "{s}: {p} vs {exact}");
+        }
+    }
+}

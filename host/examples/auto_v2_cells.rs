@@ -1,0 +1,122 @@
+//! Training data and predictions for `auto-v2`'s cell classifier
+//! (`scripts/train-auto.py` drives it).
+//!
+//! `cargo run --release -p tirroi-host --example auto_v2_cells -- features DIR OUT.csv`
+//! writes, for every frame of a dataset rendered with `--masks`, one line per 8×8 cell:
+//! `frame,cx,cy,coverage,f0..f20` (coverage: the mean of the cell's mask values,
+//! 0–255, i.e. the share of the cell covered by the target × 255).
+//!
+//! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
+//! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
+//! --predictions`; `predict-all` the same with the confidence gate off (every winner
+//! boxed: the confidence model's training data).
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use tirroi_core::Detector;
+use tirroi_core::capacity::ConstInit;
+use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, AutoV2Work, for_each_cell_features};
+use tirroi_host::imaging::image_io::read_frame;
+
+fn frames(dir: &Path) -> Vec<(String, u8)> {
+    let meta = std::fs::read_to_string(dir.join("metadata.jsonl")).expect("metadata.jsonl");
+    meta.lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).expect("json");
+            (
+                v["file"].as_str().expect("file").to_string(),
+                v["bits"].as_u64().unwrap_or(14) as u8,
+            )
+        })
+        .collect()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let (mode, dir, out) = (&args[1], PathBuf::from(&args[2]), PathBuf::from(&args[3]));
+    let list = frames(&dir);
+    let lines: Vec<String> = list
+        .par_iter()
+        .enumerate()
+        .map(|(i, (file, bits))| {
+            let f = read_frame(&dir.join(file), Some(*bits)).expect("frame");
+            let frame = f.view().expect("view");
+            let mut s = String::new();
+            if mode == "features" {
+                let mask = read_frame(&dir.join("masks").join(file), Some(8)).ok();
+                let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
+                for_each_cell_features(&frame, &mut work, |cx, cy, feats| {
+                    let mut cov = 0u32;
+                    let mut n = 0u32;
+                    if let Some(m) = &mask {
+                        for y in cy * 8..(cy * 8 + 8).min(m.height) {
+                            for x in cx * 8..(cx * 8 + 8).min(m.width) {
+                                cov += u32::from(m.pixels[y * m.width + x]);
+                                n += 1;
+                            }
+                        }
+                    }
+                    let _ = write!(s, "{i},{cx},{cy},{}", cov / n.max(1));
+                    for v in feats {
+                        let _ = write!(s, ",{v}");
+                    }
+                    s.push('\n');
+                });
+            } else {
+                let mut scratch = Box::new(AutoV2Scratch::new());
+                // `predict-all`: every winner (the confidence model's training data).
+                let gate_off = AutoV2 {
+                    min_score_permille: if mode == "predict-all" { 0 } else { 500 },
+                    ..AutoV2::default()
+                };
+                let d = gate_off.detect(&frame, &mut scratch).expect("detect");
+                match d.roi {
+                    Some(r) => {
+                        let _ = write!(
+                            s,
+                            "{file},{},{},{},{},{:.3}",
+                            r.x0,
+                            r.y0,
+                            r.x1,
+                            r.y1,
+                            d.score()
+                        );
+                    }
+                    None => {
+                        let _ = write!(s, "{file},,,,,");
+                    }
+                }
+                match scratch.work().winner() {
+                    Some(w) => {
+                        let _ = writeln!(
+                            s,
+                            ",{},{},{},{},{},{},{},{}",
+                            w.cells,
+                            w.box_w_cells,
+                            w.box_h_cells,
+                            w.sides,
+                            w.code_sum,
+                            w.code_max,
+                            w.components,
+                            w.runner_up_permille
+                        );
+                    }
+                    None => s.push_str(",,,,,,,,\n"),
+                }
+            }
+            s
+        })
+        .collect();
+    let header = if mode == "features" {
+        let mut h = "frame,cx,cy,coverage".to_string();
+        for k in 0..tirroi_core::roi::auto::learned::features::FEATURES {
+            let _ = write!(h, ",f{k}");
+        }
+        h
+    } else {
+        "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up"
+            .to_string()
+    };
+    std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");
+}
