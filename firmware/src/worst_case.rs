@@ -4,8 +4,8 @@
 //! per call over semihosting:
 //!
 //! ```text
-//! worst case=checker-7 method=otsu instructions=5712040
-//! worst case=checker-7 method=auto+prior prior=0,0,16,16 instructions=612400
+//! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248
+//! worst case=checker-7 method=auto+prior prior=0,0,16,16 instructions=612400 box=none
 //! ```
 //!
 //! then `worst done calls=N` and exit 0 (1 if a detector refused its input).
@@ -25,7 +25,7 @@ mod target {
     use cortex_m_semihosting::{debug, hprintln};
     use panic_semihosting as _;
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
-    use tirroi_core::{Frame, Method};
+    use tirroi_core::{DetectError, Detection, Frame, Method};
     use tirroi_firmware::adversarial::{self, PRIORS};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
 
@@ -70,6 +70,22 @@ mod target {
         )
     }
 
+    /// A detection's box as `x0,y0,x1,y1`, `none`, or `error` (so runs can be
+    /// compared box for box).
+    struct BoxOf<'a>(&'a Result<Detection, DetectError>);
+
+    impl core::fmt::Display for BoxOf<'_> {
+        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            match self.0 {
+                Ok(Detection { roi: Some(r), .. }) => {
+                    write!(f, "{},{},{},{}", r.x0, r.y0, r.x1, r.y1)
+                }
+                Ok(_) => f.write_str("none"),
+                Err(_) => f.write_str("error"),
+            }
+        }
+    }
+
     #[entry]
     fn main() -> ! {
         // Statics via cortex-m-rt's `static mut` in the entry function (safe references).
@@ -101,7 +117,10 @@ mod target {
                 let (result, n) = count(overhead, || DETECTORS.run(method, &frame));
                 failed |= result.is_err();
                 calls += 1;
-                hprintln!("worst case={case} method={method} instructions={n}");
+                hprintln!(
+                    "worst case={case} method={method} instructions={n} box={}",
+                    BoxOf(&result)
+                );
             }
             if DEMO_METHODS.contains(&Method::Auto) {
                 for prior in PRIORS {
@@ -109,11 +128,12 @@ mod target {
                     failed |= result.is_err();
                     calls += 1;
                     hprintln!(
-                        "worst case={case} method=auto+prior prior={},{},{},{} instructions={n}",
+                        "worst case={case} method=auto+prior prior={},{},{},{} instructions={n} box={}",
                         prior.x0,
                         prior.y0,
                         prior.x1,
-                        prior.y1
+                        prior.y1,
+                        BoxOf(&result)
                     );
                 }
             }
