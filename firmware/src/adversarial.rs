@@ -86,57 +86,45 @@ pub const COUNT: usize = MAX_CHECKER_PERIOD_PX
 
 /// The `index`-th case, `None` from [`COUNT`] on.
 pub fn case(index: usize) -> Option<Case> {
-    let mut i = index;
-    if i < MAX_CHECKER_PERIOD_PX {
-        return Some(Case::Checker(i + 1));
-    }
-    i -= MAX_CHECKER_PERIOD_PX;
-    let groups: [(&dyn Fn(usize) -> Option<Case>, usize); 10] = [
-        (
-            &|k| STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesV(p)),
-            STRIPE_PERIODS_PX.len(),
-        ),
-        (
-            &|k| STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesH(p)),
-            STRIPE_PERIODS_PX.len(),
-        ),
-        (
-            &|k| DOT_SPACINGS_PX.get(k).map(|&s| Case::Dots(s)),
-            DOT_SPACINGS_PX.len(),
-        ),
-        (
-            &|k| DOT_SPACINGS_PX.get(k).map(|&s| Case::Holes(s)),
-            DOT_SPACINGS_PX.len(),
-        ),
-        (
-            &|k| NOISE_SEEDS.get(k).map(|&s| Case::Noise(s)),
-            NOISE_SEEDS.len(),
-        ),
-        (
-            &|k| SALT_PEPPER_SEEDS.get(k).map(|&s| Case::SaltPepper(s)),
-            SALT_PEPPER_SEEDS.len(),
-        ),
-        (
-            &|k| [Case::Saturated, Case::Black, Case::Ramp].get(k).copied(),
-            3,
-        ),
-        (
-            &|k| TILE_LENGTHS.get(k).map(|&l| Case::Tiled(l)),
-            TILE_LENGTHS.len(),
-        ),
-        (
-            &|k| (k < FRAMES.len()).then_some(Case::Embedded(k)),
-            FRAMES.len(),
-        ),
-        (&|_| None, usize::MAX),
-    ];
-    for (make, len) in groups {
-        if i < len {
-            return make(i);
+    /// Takes the next group of `len` cases: `Some(k)` when `i` falls in it (k-th of
+    /// the group), else moves `i` past it.
+    fn group(i: &mut usize, len: usize) -> Option<usize> {
+        if *i < len {
+            Some(*i)
+        } else {
+            *i -= len;
+            None
         }
-        i -= len;
     }
-    None
+    let mut i = index;
+    if let Some(k) = group(&mut i, MAX_CHECKER_PERIOD_PX) {
+        return Some(Case::Checker(k + 1));
+    }
+    if let Some(k) = group(&mut i, STRIPE_PERIODS_PX.len()) {
+        return STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesV(p));
+    }
+    if let Some(k) = group(&mut i, STRIPE_PERIODS_PX.len()) {
+        return STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesH(p));
+    }
+    if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
+        return DOT_SPACINGS_PX.get(k).map(|&s| Case::Dots(s));
+    }
+    if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
+        return DOT_SPACINGS_PX.get(k).map(|&s| Case::Holes(s));
+    }
+    if let Some(k) = group(&mut i, NOISE_SEEDS.len()) {
+        return NOISE_SEEDS.get(k).map(|&s| Case::Noise(s));
+    }
+    if let Some(k) = group(&mut i, SALT_PEPPER_SEEDS.len()) {
+        return SALT_PEPPER_SEEDS.get(k).map(|&s| Case::SaltPepper(s));
+    }
+    if let Some(k) = group(&mut i, 3) {
+        return [Case::Saturated, Case::Black, Case::Ramp].get(k).copied();
+    }
+    if let Some(k) = group(&mut i, TILE_LENGTHS.len()) {
+        return TILE_LENGTHS.get(k).map(|&l| Case::Tiled(l));
+    }
+    group(&mut i, FRAMES.len()).map(Case::Embedded)
 }
 
 /// The priors `auto` tracks with on every case: the four corners (16 px boxes), the
