@@ -11,6 +11,7 @@
 //! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
 //! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
 //! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
+//! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: Otsu's score nearly flat over the bins between (least pruning) |
 //! | `saturated`, `black`, `ramp` | 3 | flat frames and a smooth ramp over the full range |
 //! | `tiled-L` | 4 | the fuzz target's frames (`fuzz/fuzz_targets/auto.rs`: a short run of random DN repeated to fill the frame), L = 3, 7, 31, 329 |
 //! | the embedded frames | 6 | the demo's rendered scenes |
@@ -51,6 +52,10 @@ pub enum Case {
     Noise(u64),
     /// Each pixel 0 or MAX_DN at random, from seed `N`.
     SaltPepper(u64),
+    /// Two spikes (0 and MAX_DN, [`SPIKE_PERMILLE`] each) with the rest spread
+    /// uniformly between them, from seed `N`: Otsu's between-class variance is nearly
+    /// flat over every bin between the spikes, so its branch and bound prunes least.
+    Spikes(u64),
     /// Every pixel saturated.
     Saturated,
     /// Every pixel 0.
@@ -71,6 +76,10 @@ const DOT_SPACINGS_PX: [usize; 2] = [2, 3];
 const NOISE_SEEDS: [u64; 4] = [1, 2, 3, 4];
 /// Seeds of the salt-and-pepper frames.
 const SALT_PEPPER_SEEDS: [u64; 2] = [1, 2];
+/// Seeds of the two-spike frames.
+const SPIKE_SEEDS: [u64; 2] = [1, 2];
+/// Share of the pixels in each spike of [`Case::Spikes`], per mille.
+pub const SPIKE_PERMILLE: u64 = 450;
 /// Lengths of the fuzz-style tiled frames (329: one more than a row, a diagonal drift).
 const TILE_LENGTHS: [usize; 4] = [3, 7, 31, 329];
 
@@ -80,6 +89,7 @@ pub const COUNT: usize = MAX_CHECKER_PERIOD_PX
     + 2 * DOT_SPACINGS_PX.len()
     + NOISE_SEEDS.len()
     + SALT_PEPPER_SEEDS.len()
+    + SPIKE_SEEDS.len()
     + 3
     + TILE_LENGTHS.len()
     + FRAMES.len();
@@ -117,6 +127,9 @@ pub fn case(index: usize) -> Option<Case> {
     }
     if let Some(k) = group(&mut i, SALT_PEPPER_SEEDS.len()) {
         return SALT_PEPPER_SEEDS.get(k).map(|&s| Case::SaltPepper(s));
+    }
+    if let Some(k) = group(&mut i, SPIKE_SEEDS.len()) {
+        return SPIKE_SEEDS.get(k).map(|&s| Case::Spikes(s));
     }
     if let Some(k) = group(&mut i, 3) {
         return [Case::Saturated, Case::Black, Case::Ramp].get(k).copied();
@@ -182,7 +195,7 @@ impl XorShift {
 pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
     let on = |b: bool| if b { MAX_DN } else { 0 };
     let mut rng = XorShift::new(match case {
-        Case::Noise(s) | Case::SaltPepper(s) => s,
+        Case::Noise(s) | Case::SaltPepper(s) | Case::Spikes(s) => s,
         Case::Tiled(l) => l as u64,
         _ => 0,
     });
@@ -210,6 +223,11 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
             Case::Holes(s) => on(!(x % s == 0 && y % s == 0)),
             Case::Noise(_) => rng.dn(),
             Case::SaltPepper(_) => on(rng.next() >> 63 == 1),
+            Case::Spikes(_) => match rng.next() % 1000 {
+                p if p < SPIKE_PERMILLE => 0,
+                p if p < 2 * SPIKE_PERMILLE => MAX_DN,
+                _ => rng.dn(),
+            },
             Case::Saturated => MAX_DN,
             Case::Black => 0,
             Case::Ramp => ((x + y) * usize::from(MAX_DN) / (FRAME_WIDTH + FRAME_HEIGHT - 2)) as u16,
@@ -229,6 +247,7 @@ impl fmt::Display for Case {
             Case::Holes(s) => write!(f, "holes-{s}"),
             Case::Noise(n) => write!(f, "noise-{n}"),
             Case::SaltPepper(n) => write!(f, "salt-pepper-{n}"),
+            Case::Spikes(n) => write!(f, "spikes-{n}"),
             Case::Saturated => f.write_str("saturated"),
             Case::Black => f.write_str("black"),
             Case::Ramp => f.write_str("ramp"),
