@@ -17,6 +17,7 @@
 #![no_std]
 #![deny(missing_docs)]
 
+pub mod adversarial;
 pub mod detectors;
 pub mod frames;
 pub mod report;

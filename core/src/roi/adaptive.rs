@@ -156,10 +156,12 @@ impl Detector for Adaptive {
             let (left, interior) = if w >= full { (r, w - full + 1) } else { (w, 0) };
             let count = rows * full;
             let hi = prefix.get(full..full + interior).unwrap_or(&[]);
-            let lo = &prefix[..interior];
+            // All in range (interior ≤ w − left, prefix holds w + 1); `get` keeps the
+            // flight build free of panic branches, an empty slice is never taken.
+            let lo = prefix.get(..interior).unwrap_or_default();
             let (mask_in, row_in) = (
-                &mut mask[left..left + interior],
-                &row[left..left + interior],
+                mask.get_mut(left..left + interior).unwrap_or_default(),
+                row.get(left..left + interior).unwrap_or_default(),
             );
             let pixels = mask_in.iter_mut().zip(row_in).zip(hi).zip(lo);
             if narrow {
@@ -177,8 +179,11 @@ impl Detector for Adaptive {
             }
             for x in (0..left).chain(left + interior..w) {
                 let (lo, hi) = (x.saturating_sub(r), (x + r + 1).min(w));
-                let sum = prefix[hi].wrapping_sub(prefix[lo]);
-                mask[x] = test(row[x], rows * (hi - lo), sum);
+                let at = |i: usize| prefix.get(i).copied().unwrap_or(0);
+                let sum = at(hi).wrapping_sub(at(lo));
+                if let (Some(m), Some(&v)) = (mask.get_mut(x), row.get(x)) {
+                    *m = test(v, rows * (hi - lo), sum);
+                }
             }
             sink(y, mask);
         }

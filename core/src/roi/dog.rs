@@ -205,26 +205,43 @@ fn gaussian_kernel(sigma: f32, r: usize, kernel: &mut [i16]) -> usize {
 /// stored offset by −2^15 in `pad` (one row with its borders), and because the Q15
 /// weights sum to exactly 2^15 the offset comes back as the constant 2^30.
 fn blur_rows_transposed(src: &[u16], dst: &mut [u16], w: usize, kernel: &[i16], pad: &mut [i16]) {
+    // Panic-free for the flight build (checked by scripts/panic-never.sh): the callers
+    // pass w ≥ 1, a kernel of 2r + 1 ≤ KERNEL_CAPACITY taps and a pad of w + taps − 1,
+    // so every `max(1)`, `get` and checked split below is a no-op that only keeps a
+    // panic branch out of the code.
+    let w = w.max(1);
     let r = kernel.len() / 2;
     let h = src.len() / w;
     // Taps padded with zero weights to a multiple of 8, so the dot product is whole
     // 8-lane blocks.
-    let taps = kernel.len().next_multiple_of(LANES);
+    let taps = kernel.len().next_multiple_of(LANES).max(LANES);
     let mut weights = [0i16; KERNEL_CAPACITY];
-    weights[..kernel.len()].copy_from_slice(kernel);
-    let weights = &weights[..taps];
-    let pad = &mut pad[..w + taps - 1];
+    for (weight, &k) in weights.iter_mut().zip(kernel) {
+        *weight = k;
+    }
+    let weights = weights.get(..taps).unwrap_or_default();
+    let Some(pad) = pad.get_mut(..w + taps - 1) else {
+        return;
+    };
     let centred = |v: u16| (v ^ 0x8000) as i16;
     for (y, row) in src.chunks_exact(w).enumerate() {
-        let (left, rest) = pad.split_at_mut(r);
-        let (middle, right) = rest.split_at_mut(w);
-        left.fill(centred(row[0]));
+        let Some((left, rest)) = pad.split_at_mut_checked(r) else {
+            return;
+        };
+        let Some((middle, right)) = rest.split_at_mut_checked(w) else {
+            return;
+        };
+        left.fill(centred(row.first().copied().unwrap_or(0)));
         for (m, &v) in middle.iter_mut().zip(row) {
             *m = centred(v);
         }
-        right.fill(centred(row[w - 1]));
+        right.fill(centred(row.last().copied().unwrap_or(0)));
         // Output column y of the transposed destination: element x at x·h + y.
-        let column = dst.get_mut(y..).unwrap_or_default().iter_mut().step_by(h);
+        let column = dst
+            .get_mut(y..)
+            .unwrap_or_default()
+            .iter_mut()
+            .step_by(h.max(1));
         for (out, window) in column.zip(pad.windows(taps)).take(w) {
             let mut acc = 0i32;
             for (kc, vc) in weights.chunks_exact(LANES).zip(window.chunks_exact(LANES)) {
@@ -310,7 +327,8 @@ impl Detector for Dog {
         find_blobs(self, work, pw, ph);
 
         let mut squares = [(0u16, 0u16, 0u16, 0u16); MAX_BLOBS];
-        for (sq, b) in squares.iter_mut().zip(&work.blobs[..work.blob_count]) {
+        let blobs = work.blobs.get(..work.blob_count).unwrap_or_default();
+        for (sq, b) in squares.iter_mut().zip(blobs) {
             let r = usize::from(self.blob_radius_px(b.level));
             let cx = (usize::from(b.x) * DOWNSAMPLE + DOWNSAMPLE / 2).min(w - 1);
             let cy = (usize::from(b.y) * DOWNSAMPLE + DOWNSAMPLE / 2).min(h - 1);
@@ -321,13 +339,16 @@ impl Detector for Dog {
                 (cy + r + 1).min(h) as u16,
             );
         }
-        let squares = &squares[..work.blob_count];
+        let squares = squares.get(..work.blob_count).unwrap_or_default();
         let mask = &mut work.mask.as_mut()[..w];
         for y in 0..h {
             mask.fill(false);
             for &(x0, y0, x1, y1) in squares {
                 if (usize::from(y0)..usize::from(y1)).contains(&y) {
-                    mask[usize::from(x0)..usize::from(x1)].fill(true);
+                    // x0 ≤ x1 ≤ w by construction.
+                    if let Some(run) = mask.get_mut(usize::from(x0)..usize::from(x1)) {
+                        run.fill(true);
+                    }
                 }
             }
             sink(y, mask);
@@ -352,34 +373,51 @@ fn gaussian_level<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, i: u8, pw:
         let sigma_half = libm::sqrtf(rest.max(0.0)) / 2.0;
         let radius = libm::ceilf(3.0 * sigma_half) as usize;
         let r = gaussian_kernel(sigma_half.max(0.25), radius, &mut work.kernel);
-        let kernel = &work.kernel[..2 * r + 1];
-        let (across, down) = work.tmp.as_mut().split_at_mut(m);
+        // Every slice below is in range (planes of the capacity, r ≤ MAX_RADIUS):
+        // `get` and the checked split keep panic branches out of the flight build.
+        let kernel = work.kernel.get(..2 * r + 1).unwrap_or_default();
+        let Some((across, down)) = work.tmp.as_mut().split_at_mut_checked(m) else {
+            return;
+        };
         let pad = work.pad.as_mut();
-        blur_rows_transposed(&work.half.as_ref()[..m], across, hw, kernel, pad);
-        blur_rows_transposed(across, &mut down[..m], hh, kernel, pad);
-        upsample(&down[..m], hw, &mut work.ring[slot].as_mut()[..n], pw);
+        let half = work.half.as_ref().get(..m).unwrap_or_default();
+        blur_rows_transposed(half, across, hw, kernel, pad);
+        let down = down.get_mut(..m).unwrap_or_default();
+        blur_rows_transposed(across, down, hh, kernel, pad);
+        let dst = work.ring[slot].as_mut().get_mut(..n).unwrap_or_default();
+        upsample(down, hw, dst, pw);
         return;
     }
     let r = gaussian_kernel(sigma, dog.radius_plane(i), &mut work.kernel);
-    let kernel = &work.kernel[..2 * r + 1];
+    let kernel = work.kernel.get(..2 * r + 1).unwrap_or_default();
     let pad = work.pad.as_mut();
     blur_rows_transposed(
-        &work.base.as_ref()[..n],
-        &mut work.tmp.as_mut()[..n],
+        work.base.as_ref().get(..n).unwrap_or_default(),
+        work.tmp.as_mut().get_mut(..n).unwrap_or_default(),
         pw,
         kernel,
         pad,
     );
-    let dst = &mut work.ring[slot].as_mut()[..n];
-    blur_rows_transposed(&work.tmp.as_ref()[..n], dst, ph, kernel, pad);
+    let dst = work.ring[slot].as_mut().get_mut(..n).unwrap_or_default();
+    blur_rows_transposed(
+        work.tmp.as_ref().get(..n).unwrap_or_default(),
+        dst,
+        ph,
+        kernel,
+        pad,
+    );
     if sigma >= HALVE_SIGMA && work.half_sigma == 0.0 {
-        halve(&work.ring[slot].as_ref()[..n], pw, work.half.as_mut());
+        let level = work.ring[slot].as_ref().get(..n).unwrap_or_default();
+        halve(level, pw, work.half.as_mut());
         work.half_sigma = sigma;
     }
 }
 
 /// 2×2 block means of the `pw`-wide plane `base` (blocks clipped at odd edges).
 fn halve(base: &[u16], pw: usize, half: &mut [u16]) {
+    // pw ≥ 1 and every index in range by the caller; `max(1)` and `get` keep panic
+    // branches out of the flight build.
+    let pw = pw.max(1);
     let ph = base.len() / pw;
     let hw = pw.div_ceil(2);
     for (hy, out) in half.chunks_exact_mut(hw).take(ph.div_ceil(2)).enumerate() {
@@ -388,7 +426,10 @@ fn halve(base: &[u16], pw: usize, half: &mut [u16]) {
             let cols = [2 * hx, (2 * hx + 1).min(pw - 1)];
             let sum: u32 = rows
                 .iter()
-                .flat_map(|&y| cols.iter().map(move |&x| u32::from(base[y * pw + x])))
+                .flat_map(|&y| {
+                    cols.iter()
+                        .map(move |&x| u32::from(base.get(y * pw + x).copied().unwrap_or(0)))
+                })
                 .sum();
             *o = ((sum + 2) / 4) as u16;
         }
@@ -399,6 +440,9 @@ fn halve(base: &[u16], pw: usize, half: &mut [u16]) {
 /// `dst`: half-plane pixel j covers plane pixels 2j and 2j + 1, so each plane pixel
 /// weighs its two nearest half-plane pixels 3/4 and 1/4 per axis (replicated edges).
 fn upsample(src: &[u16], hw: usize, dst: &mut [u16], pw: usize) {
+    // hw, pw ≥ 1 and every index in range by the caller; `max(1)` and `get` keep
+    // panic branches out of the flight build.
+    let (hw, pw) = (hw.max(1), pw.max(1));
     let hh = src.len() / hw;
     let near = |x: usize, len: usize| {
         let j = x / 2;
@@ -411,13 +455,12 @@ fn upsample(src: &[u16], hw: usize, dst: &mut [u16], pw: usize) {
     };
     for (y, out) in dst.chunks_exact_mut(pw).enumerate() {
         let (ya, yb) = near(y, hh);
-        let (ra, rb) = (&src[ya * hw..(ya + 1) * hw], &src[yb * hw..(yb + 1) * hw]);
+        let half_row = |y: usize| src.get(y * hw..(y + 1) * hw).unwrap_or_default();
+        let (ra, rb) = (half_row(ya), half_row(yb));
+        let at = |row: &[u16], x: usize| u32::from(row.get(x).copied().unwrap_or(0));
         for (x, o) in out.iter_mut().enumerate() {
             let (xa, xb) = near(x, hw);
-            let v = 9 * u32::from(ra[xa])
-                + 3 * u32::from(ra[xb])
-                + 3 * u32::from(rb[xa])
-                + u32::from(rb[xb]);
+            let v = 9 * at(ra, xa) + 3 * at(ra, xb) + 3 * at(rb, xa) + at(rb, xb);
             *o = ((v + 8) / 16) as u16;
         }
     }
@@ -449,27 +492,40 @@ fn find_blobs<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, pw: usize, ph:
             ..
         } = &mut *work;
         // Layer l is (G_l − G_{l+1})·norm; its two planes come from the ring.
+        // In range (planes of n ≤ the capacity's pixels, idx < n): `get` keeps
+        // panic branches out of the flight build.
         let planes = |l: u8| {
             (
-                &ring[usize::from(l) % 4].as_ref()[..n],
-                &ring[usize::from(l + 1) % 4].as_ref()[..n],
+                ring[usize::from(l) % 4]
+                    .as_ref()
+                    .get(..n)
+                    .unwrap_or_default(),
+                ring[usize::from(l + 1) % 4]
+                    .as_ref()
+                    .get(..n)
+                    .unwrap_or_default(),
                 norm,
             )
         };
         let response = |(a, b, k): (&[u16], &[u16], i32), idx: usize| {
-            (i32::from(a[idx]) - i32::from(b[idx])) * k
+            let at = |p: &[u16]| i32::from(p.get(idx).copied().unwrap_or(0));
+            (at(a) - at(b)) * k
         };
         let current = planes(i);
         // Same layer first (most candidates fail there), then the layers below/above.
         let mut neighbours = [current; 3];
         let mut layers = 1;
         if i > 0 {
-            neighbours[layers] = planes(i - 1);
-            layers += 1;
+            if let Some(slot) = neighbours.get_mut(layers) {
+                *slot = planes(i - 1);
+                layers += 1;
+            }
         }
         if i + 1 < layers_total {
-            neighbours[layers] = planes(i + 1);
-            layers += 1;
+            if let Some(slot) = neighbours.get_mut(layers) {
+                *slot = planes(i + 1);
+                layers += 1;
+            }
         }
         let (upper, lower, _) = current;
         for y in 0..ph {
@@ -486,7 +542,7 @@ fn find_blobs<C: FrameCapacity>(dog: &Dog, work: &mut DogWork<C>, pw: usize, ph:
                     continue;
                 }
                 let (x0, x1) = (x.saturating_sub(1), (x + 1).min(pw - 1));
-                let beaten = neighbours[..layers].iter().any(|&layer| {
+                let beaten = neighbours.iter().take(layers).any(|&layer| {
                     (y0..=y1).any(|ny| (x0..=x1).any(|nx| response(layer, ny * pw + nx) > r))
                 });
                 if !beaten {

@@ -205,7 +205,12 @@ impl<C: FrameCapacity> RoiBuilder<C> {
                 self.hull = self.hull.hull(&row);
                 self.next_row = y + 1;
             }
-            BoxRule::LargestComponent => self.close_row(y, first, &mask[first..=last]),
+            BoxRule::LargestComponent => {
+                // `first ≤ last < mask.len()` by construction; `get` keeps a panic
+                // branch out of the flight build.
+                let runs = mask.get(first..=last).unwrap_or(&[]);
+                self.close_row(y, first, runs);
+            }
         }
     }
 
@@ -257,7 +262,7 @@ impl<C: FrameCapacity> RoiBuilder<C> {
             while x < mask.len() && mask[x] {
                 x += 1;
             }
-            if let Some(run) = self.runs[self.cur_side].as_mut().get_mut(self.cur_len) {
+            if let Some(run) = self.runs[self.cur_side & 1].as_mut().get_mut(self.cur_len) {
                 *run = Run {
                     x0: (x0 + start) as u16,
                     x1: (x0 + x) as u16,
@@ -271,26 +276,30 @@ impl<C: FrameCapacity> RoiBuilder<C> {
     /// Gives every run of the current row a component: the union of the components of
     /// the 8-connected runs above it, or a new one.
     fn link_runs(&mut self, y: usize) {
+        let (cur, prev) = sides::<C>(&mut self.runs, self.cur_side);
+        let cur_len = self.cur_len;
+        // The previous row's runs (`prev_len` never exceeds the array: collect_runs
+        // stops at its end).
+        let prev = prev.as_ref().get(..self.prev_len).unwrap_or(&[]);
         let mut j0 = 0;
-        let c = self.cur_side;
-        let p = 1 - c;
-        for i in 0..self.cur_len {
-            let run = self.runs[c].as_ref()[i];
+        for run in cur.as_mut().iter_mut().take(cur_len) {
+            let (x0, x1) = (run.x0, run.x1);
             // Runs above that end left of this run's left neighbour can no longer touch
             // this or any later run.
-            while j0 < self.prev_len && self.runs[p].as_ref()[j0].x1 < run.x0 {
+            while prev.get(j0).is_some_and(|above| above.x1 < x0) {
                 j0 += 1;
             }
             let mut label = FREE;
-            let mut j = j0;
-            while j < self.prev_len && self.runs[p].as_ref()[j].x0 <= run.x1 {
-                let root = self.table.find(self.runs[p].as_ref()[j].label);
+            for above in prev.get(j0..).unwrap_or(&[]) {
+                if above.x0 > x1 {
+                    break;
+                }
+                let root = self.table.find(above.label);
                 label = if label == FREE {
                     root
                 } else {
                     self.table.union(label, root)
                 };
-                j += 1;
             }
             if label == FREE {
                 match alloc::<C>(&mut self.table, &mut self.seen_row, &mut self.table_high) {
@@ -303,12 +312,12 @@ impl<C: FrameCapacity> RoiBuilder<C> {
             }
             let width = self.width as u32;
             if let Some(comp) = self.table.stats_mut(label.index()) {
-                let run_roi = Roi::new(run.x0, y as u16, run.x1, y as u16 + 1);
+                let run_roi = Roi::new(x0, y as u16, x1, y as u16 + 1);
                 comp.roi = comp.roi.hull(&run_roi);
-                comp.area += u32::from(run.x1 - run.x0);
-                comp.first = comp.first.min(y as u32 * width + u32::from(run.x0));
+                comp.area += u32::from(x1 - x0);
+                comp.first = comp.first.min(y as u32 * width + u32::from(x0));
             }
-            self.runs[c].as_mut()[i].label = label;
+            run.label = label;
         }
     }
 
@@ -316,9 +325,9 @@ impl<C: FrameCapacity> RoiBuilder<C> {
     /// root of a current run; roots no current run reaches are complete components.
     fn retire(&mut self, y: usize) {
         let stamp = y as u16;
-        let c = self.cur_side;
-        for i in 0..self.cur_len {
-            let run = &mut self.runs[c].as_mut()[i];
+        let cur_len = self.cur_len;
+        let cur = &mut self.runs[self.cur_side & 1];
+        for run in cur.as_mut().iter_mut().take(cur_len) {
             let root = self.table.find(run.label);
             run.label = root;
             if let Some(seen) = self.seen_row.as_mut().get_mut(root.index()) {
@@ -332,7 +341,7 @@ impl<C: FrameCapacity> RoiBuilder<C> {
             };
             let c = *self.table.stats(k).unwrap_or(&NO_PIXELS);
             let is_root = parent.index() == k;
-            if is_root && self.seen_row.as_ref()[k] == stamp && c.area > 0 {
+            if is_root && self.seen_row.as_ref().get(k) == Some(&stamp) && c.area > 0 {
                 high = k + 1;
                 continue;
             }
@@ -356,6 +365,20 @@ impl<C: FrameCapacity> RoiBuilder<C> {
     }
 }
 
+/// The run arrays of the current and of the previous row (`cur_side` 0 or 1), borrowed
+/// apart from the rest of the builder.
+fn sides<C: FrameCapacity>(
+    runs: &mut [C::Runs<Run>; 2],
+    cur_side: usize,
+) -> (&mut C::Runs<Run>, &C::Runs<Run>) {
+    let [r0, r1] = runs;
+    if cur_side & 1 == 0 {
+        (r0, r1)
+    } else {
+        (r1, r0)
+    }
+}
+
 /// A free entry of `table`, as a new root with no pixels yet.
 fn alloc<C: FrameCapacity>(
     table: &mut RunComponents<C>,
@@ -365,7 +388,9 @@ fn alloc<C: FrameCapacity>(
     let k = table.parents().as_ref().iter().position(|&p| p == FREE)?;
     let label = RunLabel(k as u16);
     table.make_set(label, NO_PIXELS);
-    seen_row.as_mut()[k] = 0;
+    if let Some(seen) = seen_row.as_mut().get_mut(k) {
+        *seen = 0;
+    }
     *table_high = (*table_high).max(k + 1);
     Some(label)
 }

@@ -111,8 +111,11 @@ impl Score {
         if a < b * (1.0 - 1e-9) {
             return core::cmp::Ordering::Less;
         }
-        let (q1, r1) = (self.d2 / self.den, self.d2 % self.den);
-        let (q2, r2) = (other.d2 / other.den, other.d2 % other.den);
+        // Every score has `den ≥ 1` (both classes non-empty, or `ZERO`); `max(1)` says
+        // so to the compiler, so the flight build has no division-by-zero branch.
+        let (den1, den2) = (self.den.max(1), other.den.max(1));
+        let (q1, r1) = (self.d2 / den1, self.d2 % den1);
+        let (q2, r2) = (other.d2 / den2, other.d2 % den2);
         q1.cmp(&q2).then((r1 * other.den).cmp(&(r2 * self.den)))
     }
 }
@@ -164,7 +167,9 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
     let max_dn = frame.max_dn();
     let shift = frame.bits().saturating_sub(COARSE_SHIFT_BITS);
     let bin_width = 1usize << shift;
-    let bins = (usize::from(max_dn) >> shift) + 1;
+    // At most COARSE_BINS (max_dn >> shift < 2^7 for any bit depth); `min` tells the
+    // compiler, so indexing by a bin needs no bounds check.
+    let bins = ((usize::from(max_dn) >> shift) + 1).min(COARSE_BINS);
     let low_mask = (bin_width - 1) as u16;
 
     let lanes = &mut work.coarse;
@@ -196,8 +201,10 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
         }
     }
     let coarse = &*total;
-    let count = |b: usize| coarse[b] >> 32;
-    let sum = |b: usize| count(b) * ((b as u64) << shift) + (coarse[b] & 0xFFFF_FFFF);
+    // `b < bins ≤ COARSE_BINS`: the mask never changes the index (no bounds check).
+    let count = |b: usize| coarse[b & (COARSE_BINS - 1)] >> 32;
+    let sum =
+        |b: usize| count(b) * ((b as u64) << shift) + (coarse[b & (COARSE_BINS - 1)] & 0xFFFF_FFFF);
     let totals = Totals {
         n: frame.pixels().len() as u64,
         m: (0..bins).map(sum).sum(),
@@ -248,7 +255,9 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
             return best.t;
         }
         let [even, odd] = &mut work.fine;
-        let used = usize::from(picked) * bin_width;
+        // picked ≤ bins_per_pass, so `used` ≤ FINE_SLOTS (bin_width ≤ 2^9 = FINE_SLOTS
+        // at 16 bits); `min` only says so.
+        let used = (usize::from(picked) * bin_width).min(FINE_SLOTS);
         even[..used].fill(ConstInit::INIT);
         odd[..used].fill(ConstInit::INIT);
         let index = |v: u16| {
@@ -272,7 +281,11 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
                 even[i].increment();
             }
         }
-        let fine = |i: usize| even[i].get() + odd[i].get();
+        // `i < used ≤ FINE_SLOTS`: the mask never changes it (no bounds check).
+        let fine = |i: usize| {
+            let i = i & (FINE_SLOTS - 1);
+            even[i].get() + odd[i].get()
+        };
         // Exact scores at every DN of the picked bins.
         let (mut n0, mut m0) = (0u64, 0u64);
         for (b, &s) in slot[..bins].iter().enumerate() {

@@ -101,7 +101,9 @@ pub(crate) fn block_means(
         if let Some(out_row) = out.get_mut(py * pw..(py + 1) * pw) {
             for (px, (o, &s)) in out_row.iter_mut().zip(row_sum.iter()).enumerate() {
                 let cols = (w - px * BLOCK).min(BLOCK);
-                let n = (rows * cols) as u32;
+                // ≥ 1 pixel per block (rows, cols ≥ 1); `max(1)` says so, so the
+                // flight build has no division-by-zero branch.
+                let n = ((rows * cols) as u32).max(1);
                 *o = ((s + n / 2) / n) as u16;
             }
         }

@@ -135,6 +135,18 @@ fn for_each_gradient_row(frame: &Frame<'_>, buf: &mut [u32], mut f: impl FnMut(u
     }
 }
 
+/// The interior of a row (without its first and last pixel; empty below 3 pixels):
+/// `&row[1..len − 1]` without a panic branch.
+fn inner_px(row: &[u32]) -> &[u32] {
+    row.get(1..row.len().saturating_sub(1)).unwrap_or_default()
+}
+
+/// [`inner_px`] of a mask row, mutable.
+fn inner_px_mut(row: &mut [bool]) -> &mut [bool] {
+    let end = row.len().saturating_sub(1);
+    row.get_mut(1..end).unwrap_or_default()
+}
+
 /// What the histogram passes found.
 struct Passes {
     /// The threshold (order statistic raised to `min_gradient`), `u32::MAX` when
@@ -182,7 +194,7 @@ impl Wge {
             // it lets the compiler drop the bounds check.
             let bin = |v: u32| (v >> shift) as usize & (LANE_BINS - 1);
             for_each_gradient_row(frame, grad, |_, g| {
-                let mut pairs = g[1..w - 1].chunks_exact(2);
+                let mut pairs = inner_px(g).chunks_exact(2);
                 for pair in &mut pairs {
                     even[bin(pair[0])] += 1;
                     odd[bin(pair[1])] += 1;
@@ -226,49 +238,66 @@ impl Wge {
         // Without hulls, a second lane of counters (odd pixels) when it fits.
         let lanes = !want_hull && 2 * width <= COARSE_BINS;
         let hull_width = if want_hull || lanes { width } else { 0 };
-        let (counts, rest) = hist.split_at_mut(width);
-        let (x0s, rest) = rest.split_at_mut(hull_width);
-        let (x1s, yys) = rest.split_at_mut(if want_hull { width } else { 0 });
+        // The splits always fit (width ≤ 2^10 = COARSE_BINS; with hulls 4·width ≤
+        // COARSE_BINS, with lanes 2·width ≤ COARSE_BINS): the checked forms only keep
+        // panic branches out of the flight build.
+        let Some((counts, rest)) = hist.split_at_mut_checked(width) else {
+            return none;
+        };
+        let Some((x0s, rest)) = rest.split_at_mut_checked(hull_width) else {
+            return none;
+        };
+        let Some((x1s, yys)) = rest.split_at_mut_checked(if want_hull { width } else { 0 }) else {
+            return none;
+        };
         counts.fill(0);
         x0s.fill(0);
         let mut definite = Roi::EMPTY;
         for_each_gradient_row(frame, grad, |y, g| {
             if !want_hull {
-                let inner = &g[1..w - 1];
+                let inner = inner_px(g);
                 // Without lanes, chunks longer than the row leave it all as remainder.
                 let mut pairs = inner.chunks_exact(if lanes { 2 } else { inner.len() + 1 });
                 if lanes {
                     for pair in &mut pairs {
                         let (d0, d1) = (pair[0].wrapping_sub(lo), pair[1].wrapping_sub(lo));
-                        if (d0 as usize) < width {
-                            counts[d0 as usize] += 1;
+                        // In range when `d < width`: `get_mut` drops the bounds check's
+                        // panic branch (x0s is as long as counts when lanes are on).
+                        if let Some(c) = counts.get_mut(d0 as usize) {
+                            *c += 1;
                         }
-                        if (d1 as usize) < width {
-                            x0s[d1 as usize] += 1;
+                        if let Some(c) = x0s.get_mut(d1 as usize) {
+                            *c += 1;
                         }
                     }
                 }
                 for &v in pairs.remainder() {
-                    let d = v.wrapping_sub(lo) as usize;
-                    if d < width {
-                        counts[d] += 1;
+                    if let Some(c) = counts.get_mut(v.wrapping_sub(lo) as usize) {
+                        *c += 1;
                     }
                 }
                 return;
             }
-            let inner = &g[1..w - 1];
+            let inner = inner_px(g);
             for (i, &v) in inner.iter().enumerate() {
                 let d = v.wrapping_sub(lo) as usize;
-                if d < width {
+                // All four have `width` entries or more (with hulls): `get_mut` instead
+                // of indexing keeps panic branches out of the flight build.
+                if let (Some(c), Some(x0), Some(x1), Some(yy)) = (
+                    counts.get_mut(d),
+                    x0s.get_mut(d),
+                    x1s.get_mut(d),
+                    yys.get_mut(d),
+                ) {
                     let (xs, ys) = (i as u32 + 1, y as u32);
-                    if counts[d] == 0 {
-                        (x0s[d], x1s[d], yys[d]) = (xs, xs, ys << 16 | ys);
+                    if *c == 0 {
+                        (*x0, *x1, *yy) = (xs, xs, ys << 16 | ys);
                     } else {
-                        x0s[d] = x0s[d].min(xs);
-                        x1s[d] = x1s[d].max(xs);
-                        yys[d] = (yys[d] & 0xFFFF_0000) | ys;
+                        *x0 = (*x0).min(xs);
+                        *x1 = (*x1).max(xs);
+                        *yy = (*yy & 0xFFFF_0000) | ys;
                     }
-                    counts[d] += 1;
+                    *c += 1;
                 }
             }
             if let (Some(first), Some(last)) = (first_above(inner, hi), last_above(inner, hi)) {
@@ -292,12 +321,17 @@ impl Wge {
             let from = (threshold - lo) as usize;
             let mut roi = definite;
             let mut n = above;
-            for d in from..width {
-                if counts[d] > 0 {
-                    let (y0, y1) = ((yys[d] >> 16) as u16, (yys[d] & 0xFFFF) as u16);
-                    let r = Roi::new(x0s[d] as u16, y0, x1s[d] as u16 + 1, y1 + 1);
+            let values = counts
+                .iter()
+                .zip(x0s.iter())
+                .zip(x1s.iter())
+                .zip(yys.iter());
+            for (((&count, &x0), &x1), &yy) in values.take(width).skip(from) {
+                if count > 0 {
+                    let (y0, y1) = ((yy >> 16) as u16, (yy & 0xFFFF) as u16);
+                    let r = Roi::new(x0 as u16, y0, x1 as u16 + 1, y1 + 1);
                     roi = roi.hull(&r);
-                    n += counts[d];
+                    n += count;
                 }
             }
             ((!roi.is_empty()).then_some(roi), n)
@@ -324,7 +358,7 @@ impl Wge {
         }
         sink(0, mask);
         for_each_gradient_row(frame, &mut gradient.as_mut()[..w], |y, g| {
-            for (m, &v) in mask[1..w - 1].iter_mut().zip(&g[1..w - 1]) {
+            for (m, &v) in inner_px_mut(mask).iter_mut().zip(inner_px(g)) {
                 *m = v >= threshold;
             }
             sink(y, mask);

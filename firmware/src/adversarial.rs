@@ -1,0 +1,258 @@
+//! Adversarial 328×248 frames for the worst-case instruction bounds (issue 18, part 2),
+//! made deterministically on board (nothing is stored but this code): every detector's
+//! data-dependent work (histogram bins in use, gradient strengths, runs and components
+//! of the mask, DoG extrema, `auto`'s edge components and refinement) is pushed to its
+//! extreme by one of them.
+//!
+//! | kind | cases | what it stresses |
+//! |---|---|---|
+//! | `checker-P`, P = 1..=64 | 64 | edges at every spatial period: gradients, runs per row, components of every size |
+//! | `stripes-v-P`, `stripes-h-P`, P = 1, 2 | 4 | all-edge frames: every column (row) an edge |
+//! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
+//! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
+//! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
+//! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: Otsu's score nearly flat over the bins between (least pruning) |
+//! | `saturated`, `black`, `ramp` | 3 | flat frames and a smooth ramp over the full range |
+//! | `tiled-L` | 4 | the fuzz target's frames (`fuzz/fuzz_targets/auto.rs`: a short run of random DN repeated to fill the frame), L = 3, 7, 31, 329 |
+//! | the embedded frames | 6 | the demo's rendered scenes |
+//!
+//! `auto` with a prior is run with each of [`PRIORS`] (corners, the whole frame, one
+//! pixel, boxes partly and wholly outside the frame).
+
+use core::fmt;
+
+use tirroi_core::Roi;
+use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+
+use crate::BITS;
+use crate::frames::FRAMES;
+
+/// The largest DN at the demo's bit depth (saturation).
+pub const MAX_DN: u16 = (1u16 << BITS) - 1;
+
+/// Largest checkerboard period, px (a quarter of the frame height: beyond it the
+/// board is a few big blocks, which the periods below already cover in kind).
+pub const MAX_CHECKER_PERIOD_PX: usize = 64;
+
+/// One adversarial frame: its kind and its parameter (period, spacing, seed, length or
+/// index of the embedded frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Case {
+    /// Square checkerboard of period `P` px (cells of P×P, 0 and saturated DN).
+    Checker(usize),
+    /// Vertical stripes `P` px wide, alternately 0 and saturated.
+    StripesV(usize),
+    /// Horizontal stripes `P` px high.
+    StripesH(usize),
+    /// Saturated single pixels every `S` px in x and y on black.
+    Dots(usize),
+    /// Black single pixels every `S` px in x and y on saturated.
+    Holes(usize),
+    /// Uniform noise over 0..=MAX_DN from seed `N`.
+    Noise(u64),
+    /// Each pixel 0 or MAX_DN at random, from seed `N`.
+    SaltPepper(u64),
+    /// Two spikes (0 and MAX_DN, [`SPIKE_PERMILLE`] each) with the rest spread
+    /// uniformly between them, from seed `N`: Otsu's between-class variance is nearly
+    /// flat over every bin between the spikes, so its branch and bound prunes least.
+    Spikes(u64),
+    /// Every pixel saturated.
+    Saturated,
+    /// Every pixel 0.
+    Black,
+    /// A ramp over the whole range along x + y.
+    Ramp,
+    /// `L` random DN (seed `L`) repeated in raster order to fill the frame.
+    Tiled(usize),
+    /// The embedded frame of this index ([`FRAMES`]).
+    Embedded(usize),
+}
+
+/// The all-edge stripe widths, px.
+const STRIPE_PERIODS_PX: [usize; 2] = [1, 2];
+/// The lattice spacings of isolated pixels, px (2: the densest 8-isolated lattice).
+const DOT_SPACINGS_PX: [usize; 2] = [2, 3];
+/// Seeds of the noise frames.
+const NOISE_SEEDS: [u64; 4] = [1, 2, 3, 4];
+/// Seeds of the salt-and-pepper frames.
+const SALT_PEPPER_SEEDS: [u64; 2] = [1, 2];
+/// Seeds of the two-spike frames.
+const SPIKE_SEEDS: [u64; 2] = [1, 2];
+/// Share of the pixels in each spike of [`Case::Spikes`], per mille.
+pub const SPIKE_PERMILLE: u64 = 450;
+/// Lengths of the fuzz-style tiled frames (329: one more than a row, a diagonal drift).
+const TILE_LENGTHS: [usize; 4] = [3, 7, 31, 329];
+
+/// Number of cases ([`case`] is `Some` for `0..COUNT`).
+pub const COUNT: usize = MAX_CHECKER_PERIOD_PX
+    + 2 * STRIPE_PERIODS_PX.len()
+    + 2 * DOT_SPACINGS_PX.len()
+    + NOISE_SEEDS.len()
+    + SALT_PEPPER_SEEDS.len()
+    + SPIKE_SEEDS.len()
+    + 3
+    + TILE_LENGTHS.len()
+    + FRAMES.len();
+
+/// The `index`-th case, `None` from [`COUNT`] on.
+pub fn case(index: usize) -> Option<Case> {
+    /// Takes the next group of `len` cases: `Some(k)` when `i` falls in it (k-th of
+    /// the group), else moves `i` past it.
+    fn group(i: &mut usize, len: usize) -> Option<usize> {
+        if *i < len {
+            Some(*i)
+        } else {
+            *i -= len;
+            None
+        }
+    }
+    let mut i = index;
+    if let Some(k) = group(&mut i, MAX_CHECKER_PERIOD_PX) {
+        return Some(Case::Checker(k + 1));
+    }
+    if let Some(k) = group(&mut i, STRIPE_PERIODS_PX.len()) {
+        return STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesV(p));
+    }
+    if let Some(k) = group(&mut i, STRIPE_PERIODS_PX.len()) {
+        return STRIPE_PERIODS_PX.get(k).map(|&p| Case::StripesH(p));
+    }
+    if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
+        return DOT_SPACINGS_PX.get(k).map(|&s| Case::Dots(s));
+    }
+    if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
+        return DOT_SPACINGS_PX.get(k).map(|&s| Case::Holes(s));
+    }
+    if let Some(k) = group(&mut i, NOISE_SEEDS.len()) {
+        return NOISE_SEEDS.get(k).map(|&s| Case::Noise(s));
+    }
+    if let Some(k) = group(&mut i, SALT_PEPPER_SEEDS.len()) {
+        return SALT_PEPPER_SEEDS.get(k).map(|&s| Case::SaltPepper(s));
+    }
+    if let Some(k) = group(&mut i, SPIKE_SEEDS.len()) {
+        return SPIKE_SEEDS.get(k).map(|&s| Case::Spikes(s));
+    }
+    if let Some(k) = group(&mut i, 3) {
+        return [Case::Saturated, Case::Black, Case::Ramp].get(k).copied();
+    }
+    if let Some(k) = group(&mut i, TILE_LENGTHS.len()) {
+        return TILE_LENGTHS.get(k).map(|&l| Case::Tiled(l));
+    }
+    group(&mut i, FRAMES.len()).map(Case::Embedded)
+}
+
+/// The priors `auto` tracks with on every case: the four corners (16 px boxes), the
+/// whole frame, the last pixel, a box half outside the right edge, one wholly outside.
+pub const PRIORS: [Roi; 8] = [
+    Roi::new(0, 0, 16, 16),
+    Roi::new(FRAME_WIDTH as u16 - 16, 0, FRAME_WIDTH as u16, 16),
+    Roi::new(0, FRAME_HEIGHT as u16 - 16, 16, FRAME_HEIGHT as u16),
+    Roi::new(
+        FRAME_WIDTH as u16 - 16,
+        FRAME_HEIGHT as u16 - 16,
+        FRAME_WIDTH as u16,
+        FRAME_HEIGHT as u16,
+    ),
+    Roi::new(0, 0, FRAME_WIDTH as u16, FRAME_HEIGHT as u16),
+    Roi::new(
+        FRAME_WIDTH as u16 - 1,
+        FRAME_HEIGHT as u16 - 1,
+        FRAME_WIDTH as u16,
+        FRAME_HEIGHT as u16,
+    ),
+    Roi::new(FRAME_WIDTH as u16 - 8, 100, FRAME_WIDTH as u16 + 8, 140),
+    Roi::new(
+        FRAME_WIDTH as u16 + 10,
+        FRAME_HEIGHT as u16 + 10,
+        FRAME_WIDTH as u16 + 40,
+        FRAME_HEIGHT as u16 + 40,
+    ),
+];
+
+/// xorshift64* (Vigna 2016): a fixed, tiny generator, so every target makes the same
+/// frames.
+struct XorShift(u64);
+
+impl XorShift {
+    fn new(seed: u64) -> Self {
+        // Any non-zero state; the odd constant spreads small seeds.
+        XorShift(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    /// A DN uniform on 0..=MAX_DN (the top bits of the output).
+    fn dn(&mut self) -> u16 {
+        (self.next() >> (64 - u32::from(BITS))) as u16
+    }
+}
+
+/// Writes `case` into `frame` (row-major DN).
+pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
+    let on = |b: bool| if b { MAX_DN } else { 0 };
+    let mut rng = XorShift::new(match case {
+        Case::Noise(s) | Case::SaltPepper(s) | Case::Spikes(s) => s,
+        Case::Tiled(l) => l as u64,
+        _ => 0,
+    });
+    if let Case::Embedded(k) = case {
+        if let Some(embedded) = FRAMES.get(k) {
+            for (dn, be) in frame.iter_mut().zip(embedded.be_bytes.chunks_exact(2)) {
+                *dn = u16::from_be_bytes([be[0], be[1]]);
+            }
+        }
+        return;
+    }
+    let mut tile = [0u16; TILE_LENGTHS[TILE_LENGTHS.len() - 1]];
+    if let Case::Tiled(len) = case {
+        for t in tile.iter_mut().take(len) {
+            *t = rng.dn();
+        }
+    }
+    for (i, dn) in frame.iter_mut().enumerate() {
+        let (x, y) = (i % FRAME_WIDTH, i / FRAME_WIDTH);
+        *dn = match case {
+            Case::Checker(p) => on((x / p + y / p) % 2 == 1),
+            Case::StripesV(p) => on((x / p) % 2 == 1),
+            Case::StripesH(p) => on((y / p) % 2 == 1),
+            Case::Dots(s) => on(x % s == 0 && y % s == 0),
+            Case::Holes(s) => on(!(x % s == 0 && y % s == 0)),
+            Case::Noise(_) => rng.dn(),
+            Case::SaltPepper(_) => on(rng.next() >> 63 == 1),
+            Case::Spikes(_) => match rng.next() % 1000 {
+                p if p < SPIKE_PERMILLE => 0,
+                p if p < 2 * SPIKE_PERMILLE => MAX_DN,
+                _ => rng.dn(),
+            },
+            Case::Saturated => MAX_DN,
+            Case::Black => 0,
+            Case::Ramp => ((x + y) * usize::from(MAX_DN) / (FRAME_WIDTH + FRAME_HEIGHT - 2)) as u16,
+            Case::Tiled(len) => tile.get(i % len.max(1)).copied().unwrap_or(0),
+            Case::Embedded(_) => 0,
+        };
+    }
+}
+
+impl fmt::Display for Case {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Case::Checker(p) => write!(f, "checker-{p}"),
+            Case::StripesV(p) => write!(f, "stripes-v-{p}"),
+            Case::StripesH(p) => write!(f, "stripes-h-{p}"),
+            Case::Dots(s) => write!(f, "dots-{s}"),
+            Case::Holes(s) => write!(f, "holes-{s}"),
+            Case::Noise(n) => write!(f, "noise-{n}"),
+            Case::SaltPepper(n) => write!(f, "salt-pepper-{n}"),
+            Case::Spikes(n) => write!(f, "spikes-{n}"),
+            Case::Saturated => f.write_str("saturated"),
+            Case::Black => f.write_str("black"),
+            Case::Ramp => f.write_str("ramp"),
+            Case::Tiled(l) => write!(f, "tiled-{l}"),
+            Case::Embedded(k) => f.write_str(FRAMES.get(k).map_or("embedded-?", |e| e.name)),
+        }
+    }
+}

@@ -1,0 +1,105 @@
+//! # tirroi-panic-never
+//!
+//! A link-time proof that the flight calls cannot panic (issue 18, part 1): this
+//! bare-metal binary calls what the firmware calls — each detector through the
+//! firmware's registry calls ([`Detectors::run`] for the paper's four and `auto`,
+//! [`Detectors::track`] for `auto` with a prior) and the on-board camera model
+//! ([`synth::setup`], [`synth::expose_scene`]) — on inputs the optimiser cannot see
+//! ([`black_box`]), and its panic handler calls a function that exists nowhere. The
+//! release build (fat LTO, `panic = "abort"`, as the firmware's) drops every panic
+//! branch the compiler proves unreachable; if one is left, the panic handler is still
+//! referenced and the link fails with `undefined symbol: tirroi_panic_path_found`.
+//!
+//! Which components are linked is chosen by cargo features (`otsu`, `adaptive`, `wge`,
+//! `dog`, `auto`, `auto-prior`, `sensor`); `scripts/panic-never.sh` builds the required
+//! set, and on a failure or for components not yet required, each one alone, and names
+//! the functions and source lines that still reach a panic.
+//!
+//! The binary is never run: it has no start-up code and no memory map.
+#![no_std]
+#![no_main]
+#![deny(missing_docs)]
+
+use core::hint::black_box;
+
+#[allow(unused_imports)]
+use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+#[allow(unused_imports)]
+use tirroi_core::{Frame, Method, Roi};
+#[allow(unused_imports)]
+use tirroi_firmware::{Detectors, Workspace, synth};
+
+unsafe extern "C" {
+    /// Defined nowhere: any reference to it left after optimisation is a link error,
+    /// and only the panic handler references it. `safe`: calling it needs no `unsafe`
+    /// block (it is never called; the link fails first).
+    safe fn tirroi_panic_path_found() -> !;
+}
+
+/// The panic handler: reachable only through a panic branch the optimiser kept.
+#[panic_handler]
+fn panic(_info: &core::panic::PanicInfo<'_>) -> ! {
+    tirroi_panic_path_found()
+}
+
+/// Runs one method through the firmware's registry call on an opaque frame.
+#[allow(dead_code)]
+#[inline(never)]
+fn detect(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
+    // Any frame size and bit depth the caller could pass, not only the reference one.
+    let width = black_box(FRAME_WIDTH);
+    let height = black_box(FRAME_HEIGHT);
+    let bits = black_box(DEFAULT_BIT_DEPTH);
+    if let Ok(frame) = Frame::new(black_box(pixels), width, height, bits) {
+        let _ = black_box(detectors.run(method, &frame));
+    }
+}
+
+/// The entry point the linker keeps (`ld.lld`'s default entry symbol): every checked
+/// call is reachable from here. `no_mangle` is the only way to name it for the linker.
+#[unsafe(no_mangle)]
+pub extern "C" fn _start() -> ! {
+    let mut pixels = [0u16; FRAME_PIXELS];
+    let pixels = black_box(&mut pixels);
+    let mut detectors = Detectors::new();
+    let detectors = black_box(&mut detectors);
+    #[cfg(feature = "otsu")]
+    detect(detectors, Method::Otsu, pixels);
+    #[cfg(feature = "adaptive")]
+    detect(detectors, Method::Adaptive, pixels);
+    #[cfg(feature = "wge")]
+    detect(detectors, Method::Wge, pixels);
+    #[cfg(feature = "dog")]
+    detect(detectors, Method::Dog, pixels);
+    #[cfg(feature = "auto")]
+    detect(detectors, Method::Auto, pixels);
+    #[cfg(feature = "auto-prior")]
+    {
+        let width = black_box(FRAME_WIDTH);
+        let height = black_box(FRAME_HEIGHT);
+        if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, DEFAULT_BIT_DEPTH) {
+            // Any prior box, also one outside the frame.
+            let prior = black_box(Roi::new(
+                black_box(0),
+                black_box(0),
+                black_box(0),
+                black_box(0),
+            ));
+            let _ = black_box(detectors.track(prior, &frame));
+        }
+    }
+    #[cfg(feature = "sensor")]
+    {
+        let mut tables = synth::Tables::new();
+        let mut ws = Workspace {
+            frame: pixels,
+            detectors,
+            tables: black_box(&mut tables),
+        };
+        synth::setup(&mut ws);
+        let _ = black_box(synth::expose_scene(&mut ws));
+    }
+    loop {
+        core::hint::spin_loop();
+    }
+}
