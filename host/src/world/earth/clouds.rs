@@ -67,24 +67,6 @@ pub const OCTAVE_GAIN: f64 = 0.65;
 /// North–south compression of the coarse octaves (their features run east–west, as
 /// frontal cloud bands and cirrus streets).
 pub const ZONAL_STRETCH: f64 = 2.0;
-/// Cloud depth ΔT, K, above which a point counts as deep convective and its coarse
-/// octaves fade (see [`DEEP_COARSE_GAIN`]): below it (low and mid-level cloud, fronts)
-/// the texture keeps its synoptic-scale decks.
-pub const DEEP_START_K: f64 = 25.0;
-/// Weight of the coarse octaves (lattices ≥ 100 km) at the deepest cloud
-/// ([`MAX_CLOUD_COLD_K`]), relative to the rest; blended by a smoothstep from 1 at
-/// [`DEEP_START_K`]. Deep tropical convection organises in mesoscale systems (anvils of
-/// 100–300 km around 10–50 km cores), not in the 1 000 km decks of mid-latitude fronts:
-/// with the full synoptic octaves its patches came out too steep (spectral slope
-/// −3.4…−3.7 against the real −3.1). The noise is rescaled to keep its variance, so the
-/// thresholds (quantiles) and the edge widths (σ units) keep their meaning.
-pub const DEEP_COARSE_GAIN: f64 = 0.3;
-/// Share of a deep-convective cloud's depth ΔT reached at its edge (replaces
-/// [`EDGE_DEPTH_SHARE`] as the regime weight goes to 1): 1, i.e. no deepening towards
-/// the core. Anvils spread at the tropopause, so their tops are nearly isothermal;
-/// the core deepening of the other regimes put ~20 K of smooth large-scale variance
-/// inside the decks (and, with the mesoscale octaves, too many > 10 K edge steps).
-pub const DEEP_EDGE_DEPTH_SHARE: f64 = 1.0;
 /// Width of the cloud-edge transition in units of the noise's standard deviation.
 pub const EDGE_WIDTH_SIGMA: f64 = 0.10;
 /// The edge width grows as (ΔT / [`MIN_CLOUD_COLD_K`])^this: deep, cold cloud fringes
@@ -209,9 +191,6 @@ pub struct CloudField {
     octaves: Vec<Octave>,
     quantiles: [f64; QUANTILES + 1],
     sigma: f64,
-    /// Variance of the coarse octaves' sum and of the rest's (noise units²).
-    coarse_var: f64,
-    rest_var: f64,
     clear_t_k: Vec<f64>,
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
@@ -230,8 +209,6 @@ impl Clone for CloudField {
             octaves: self.octaves.clone(),
             quantiles: self.quantiles,
             sigma: self.sigma,
-            coarse_var: self.coarse_var,
-            rest_var: self.rest_var,
             clear_t_k: self.clear_t_k.clone(),
             cells: self.cells.clone(),
             balance: self.balance.clone(),
@@ -330,8 +307,6 @@ impl CloudField {
             octaves,
             quantiles: [0.0; QUANTILES + 1],
             sigma: 1.0,
-            coarse_var: 1.0,
-            rest_var: 0.0,
             clear_t_k,
             cells: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
@@ -355,22 +330,6 @@ impl CloudField {
                 field.noise(p, 0..field.octaves.len())
             })
             .collect();
-        // The variance split between the coarse octaves and the rest (for the
-        // deep-convective reweighting), on the first samples again.
-        let mut vrng = Xoshiro128pp::seed_from_u64(0x5A3F_1E5D);
-        let (mut sc, mut sc2, mut sr, mut sr2) = (0.0, 0.0, 0.0, 0.0);
-        for _ in 0..DISTRIBUTION_SAMPLES {
-            let z = f64::from(vrng.next_u32()) / 4_294_967_296.0 * 2.0 - 1.0;
-            let phi = f64::from(vrng.next_u32()) / 4_294_967_296.0 * std::f64::consts::TAU;
-            let r = (1.0 - z * z).sqrt();
-            let p = [r * libm::cos(phi), r * libm::sin(phi), z];
-            let c = field.noise(p, 0..COARSE_OCTAVES);
-            let rest = field.noise(p, COARSE_OCTAVES..field.octaves.len());
-            (sc, sc2, sr, sr2) = (sc + c, sc2 + c * c, sr + rest, sr2 + rest * rest);
-        }
-        let n = DISTRIBUTION_SAMPLES as f64;
-        field.coarse_var = (sc2 / n - (sc / n) * (sc / n)).max(0.0);
-        field.rest_var = (sr2 / n - (sr / n) * (sr / n)).max(0.0);
         values.sort_by(f64::total_cmp);
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / values.len() as f64;
@@ -452,7 +411,7 @@ impl CloudField {
 
     /// What a point needs before its cell's threshold shift: (clear temperature with
     /// grain, K; cloud depth ΔT, K; base threshold θ; noise n).
-    fn point(&self, lat_deg: f64, lon_deg: f64, coarse: f64, rest: f64, n_fine: f64) -> Point {
+    fn point(&self, lat_deg: f64, lon_deg: f64, n: f64, n_fine: f64) -> Point {
         let f = self.flux_at(lat_deg, lon_deg);
         let t_clear = self
             .clear_t(lat_deg)
@@ -473,17 +432,6 @@ impl CloudField {
         // ΔT (thin cirrus fringes of anvils and fronts).
         let depth = dt / MIN_CLOUD_COLD_K;
         let width = EDGE_WIDTH_SIGMA * self.sigma * depth * depth * depth.sqrt();
-        // Deep convection: fade the synoptic octaves, keep the noise's variance.
-        let deep = deep_weight(dt);
-        let n = if deep > 0.0 {
-            let a = 1.0 - (1.0 - DEEP_COARSE_GAIN) * deep;
-            let k = ((self.coarse_var + self.rest_var)
-                / (a * a * self.coarse_var + self.rest_var).max(1e-12))
-            .sqrt();
-            k * (a * coarse + rest)
-        } else {
-            coarse + rest
-        };
         Point {
             t_clear: t_clear + grain,
             dt,
@@ -764,10 +712,7 @@ impl CloudField {
         let m = smoothstep(x / p.width + 0.5);
         // Deeper (colder) towards a cloud's core: 0.65 ΔT at the edge, 1.35 ΔT well inside.
         let core = smoothstep(x / (1.2 * self.sigma));
-        // Deep convection: flat anvil tops (the share goes to DEEP_EDGE_DEPTH_SHARE).
-        let share =
-            EDGE_DEPTH_SHARE + (DEEP_EDGE_DEPTH_SHARE - EDGE_DEPTH_SHARE) * deep_weight(p.dt);
-        let depth = share + 2.0 * (1.0 - share) * core;
+        let depth = EDGE_DEPTH_SHARE + 2.0 * (1.0 - EDGE_DEPTH_SHARE) * core;
         p.t_clear - (m * p.dt * depth).min(MAX_LOCAL_COLD_K)
     }
 
@@ -784,7 +729,7 @@ impl CloudField {
         let last = self.octaves.len();
         let mid = self.noise(p, COARSE_OCTAVES..last - 1);
         let fine = self.noise(p, last - 1..last);
-        self.point(lat, lon, coarse, mid + fine, fine)
+        self.point(lat, lon, coarse + mid + fine, fine)
     }
 
     /// Brightness temperature of the texture at (`lat_deg`, `lon_deg`), K: the
@@ -861,10 +806,4 @@ impl Tile {
         let b = at(k + TILE_NODES) + (at(k + TILE_NODES + 1) - at(k + TILE_NODES)) * tx;
         TILE_OFFSET_K + (a + (b - a) * ty) * TILE_STEP_K
     }
-}
-
-/// Weight of the deep-convective regime at cloud depth `dt_k`: 0 up to
-/// [`DEEP_START_K`], smoothly 1 at [`MAX_CLOUD_COLD_K`].
-fn deep_weight(dt_k: f64) -> f64 {
-    smoothstep((dt_k - DEEP_START_K) / (MAX_CLOUD_COLD_K - DEEP_START_K))
 }
