@@ -178,6 +178,26 @@ impl Library {
             .map(|&d| Ok((d, olr_grid(file, d)?)))
             .collect::<Result<_, DatasetError>>()?;
         let factor = file.earth_model.eclipse_factor;
+        // The cloud texture once per day, from the sunlit grid (filled in parallel
+        // inside); the eclipse map of the day shares it with its temperatures ×
+        // factor^¼ (the same clouds, each cell's flux × factor).
+        let clouds: BTreeMap<usize, Arc<CloudField>> = match file.earth_model.texture {
+            EarthTexture::Paper => BTreeMap::new(),
+            EarthTexture::Clouds => {
+                let mut cloud_days: Vec<usize> = earth_keys.iter().map(|k| k.1).collect();
+                cloud_days.sort_unstable();
+                cloud_days.dedup();
+                cloud_days
+                    .iter()
+                    .map(|&day| {
+                        let field = CloudField::new(&grids[&day], day as u64, file.dataset.seed);
+                        field.fill();
+                        (day, Arc::new(field))
+                    })
+                    .collect()
+            }
+        };
+        let eclipse_t_scale = f64::from(factor).sqrt().sqrt();
         let earth: HashMap<_, _> = earth_keys
             .par_iter()
             .map(|&(ill, day)| {
@@ -194,9 +214,13 @@ impl Library {
                     match file.earth_model.texture {
                         EarthTexture::Paper => m,
                         // The same clouds by day and seed, whatever the illumination.
-                        EarthTexture::Clouds => {
-                            m.with_clouds(CloudField::new(grid, day as u64, file.dataset.seed))
-                        }
+                        EarthTexture::Clouds => m.with_shared_clouds(
+                            Arc::clone(&clouds[&day]),
+                            match ill {
+                                Illumination::Sunlit => 1.0,
+                                Illumination::Eclipse => eclipse_t_scale,
+                            },
+                        ),
                     }
                 });
                 map.map(|m| ((ill, day), Arc::new(m)))

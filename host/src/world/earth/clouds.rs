@@ -164,8 +164,9 @@ struct Balance {
 /// quantised to [`TILE_STEP_K`], and the cell's scale s.
 #[derive(Debug, Clone)]
 struct Tile {
-    /// (T − [`TILE_OFFSET_K`]) / [`TILE_STEP_K`], rounded, row-major (south → north).
-    t: Box<[u16; TILE_NODES * TILE_NODES]>,
+    /// (T − [`TILE_OFFSET_K`]) / [`TILE_STEP_K`], rounded, row-major (south → north);
+    /// inline, so a lookup follows one pointer (the cell's box) to its nodes.
+    t: [u16; TILE_NODES * TILE_NODES],
     /// The cell's scale s: its flux over the tile's mean σT⁴, to the ¼ power.
     s: f64,
 }
@@ -467,7 +468,7 @@ impl CloudField {
         }
         let (lat0, lon0) = (row as f64 - 90.0, col as f64);
         let last = (TILE_NODES - 1) as f64;
-        let mut t = Box::new([0u16; TILE_NODES * TILE_NODES]);
+        let mut t = [0u16; TILE_NODES * TILE_NODES];
         // sin/cos of each node column's longitude once (unit vectors are separable).
         let lon_sc: Vec<(f64, f64)> = (0..TILE_NODES)
             .map(|j| {
@@ -556,7 +557,7 @@ impl CloudField {
             + size_of::<OnceLock<Balance>>()
             + size_of::<OnceLock<Box<Tile>>>())
             + cells * size_of::<Cell>()
-            + tiles * (size_of::<Tile>() + size_of::<[u16; TILE_NODES * TILE_NODES]>())
+            + tiles * size_of::<Tile>()
             + (self.flux.len() + self.table.len()) * size_of::<f32>()
     }
 

@@ -104,6 +104,10 @@ pub struct EarthMap {
     node_temps: Vec<f32>,
     /// Smallest and largest cell radiance.
     min_max: (f32, f32),
-    /// The sub-grid cloud texture (`earth_model.texture = "clouds"`), if any.
-    clouds: Option<Box<clouds::CloudField>>,
+    /// The sub-grid cloud texture (`earth_model.texture = "clouds"`), if any (shared
+    /// between the sunlit and the eclipse map of a day).
+    clouds: Option<std::sync::Arc<clouds::CloudField>>,
+    /// Factor on the texture's temperatures (1 sunlit; (eclipse factor)^¼ in eclipse,
+    /// so every cell's σT⁴ scales by the eclipse factor exactly).
+    cloud_t_scale: f64,
 }

@@ -74,6 +74,7 @@ impl EarthMap {
             node_temps,
             min_max,
             clouds: None,
+            cloud_t_scale: 1.0,
         })
     }
 
@@ -82,15 +83,36 @@ impl EarthMap {
     /// ([`CloudField::temperature_k`](super::CloudField::temperature_k)) instead of the
     /// mesh cell. Builds the whole texture now ([`CloudField::fill`](super::CloudField::fill),
     /// in parallel), so rendering only reads it.
-    pub fn with_clouds(mut self, clouds: super::CloudField) -> EarthMap {
+    pub fn with_clouds(self, clouds: super::CloudField) -> EarthMap {
         clouds.fill();
-        self.clouds = Some(Box::new(clouds));
+        self.with_shared_clouds(std::sync::Arc::new(clouds), 1.0)
+    }
+
+    /// This map with a texture built (and filled) for another map, its temperatures
+    /// times `temperature_scale` (> 0): the eclipse map of a day takes the sunlit map's
+    /// texture with (eclipse factor)^¼, so each cell's flux is the sunlit one × the
+    /// eclipse factor exactly, the same clouds, and the set-up is paid once per day.
+    /// Does not fill `clouds` (cells still build on first use if nobody did).
+    pub fn with_shared_clouds(
+        mut self,
+        clouds: std::sync::Arc<super::CloudField>,
+        temperature_scale: f64,
+    ) -> EarthMap {
+        self.clouds = Some(clouds);
+        self.cloud_t_scale = temperature_scale;
         self
     }
 
     /// The cloud texture, if the map has one.
     pub fn clouds(&self) -> Option<&super::CloudField> {
         self.clouds.as_deref()
+    }
+
+    /// Factor on the cloud texture's temperatures in this map (1 unless built by
+    /// [`EarthMap::with_shared_clouds`] with another): the rendered brightness
+    /// temperature is this × [`CloudField::temperature_k`](super::CloudField::temperature_k).
+    pub fn cloud_temperature_scale(&self) -> f64 {
+        self.cloud_t_scale
     }
 
     /// The mesh size, degrees per cell (1/k).
