@@ -299,3 +299,59 @@ fn literal_noise_vanishes_in_quantisation_and_frames_saturate() {
     let mut narrow = NoiseField::new(loud, 4.0, 100, 9).unwrap();
     assert!(expose_frame(&signal, W, &m, Some(&mut narrow), &mut out).is_err());
 }
+
+/// The frame of [`field_frame`] through the flight path's loop
+/// ([`NoiseField::for_each_in_row`]) instead of the row iterator.
+fn field_frame_fast(sigmas: NoiseSigmas, corr: f32, seed: u64) -> Vec<f32> {
+    let mut f = NoiseField::new(sigmas, corr, W, seed).unwrap();
+    let mut out = Vec::with_capacity(W * H);
+    for _ in 0..H {
+        f.for_each_in_row(|n| out.push(n));
+    }
+    out
+}
+
+#[test]
+fn flight_loop_is_the_row_iterator_bit_for_bit_with_normal_statistics() {
+    let s = NoiseSigmas {
+        johnson_dn: 3.0,
+        flicker_dn: 2.0,
+        thermal_dn: 1.0,
+    };
+    for (corr, seed) in [(DEFAULT_FLICKER_CORRELATION_PX, 7), (0.0, 8), (1.5, 2026)] {
+        let slow = field_frame(s, corr, seed);
+        let fast = field_frame_fast(s, corr, seed);
+        assert_eq!(fast.len(), W * H);
+        let same = slow
+            .iter()
+            .zip(&fast)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(
+            same,
+            "ℓ = {corr}, seed {seed}: the fast loop differs from next_row"
+        );
+    }
+    // White noise alone: mean 0, σ = √(σ_J² + σ_th²), and the share within 1, 2, 3 σ
+    // against the normal law's closed form erf(k/√2) = 0.682 689, 0.954 500, 0.997 300.
+    let white = NoiseSigmas {
+        johnson_dn: 4.0,
+        flicker_dn: 0.0,
+        thermal_dn: 3.0,
+    };
+    let v = field_frame_fast(white, DEFAULT_FLICKER_CORRELATION_PX, 11);
+    let n = v.len() as f64;
+    let sigma = 5.0;
+    let (mean, std) = mean_std(&v);
+    assert!(mean.abs() < 5.0 * sigma / n.sqrt(), "mean {mean}");
+    assert!(rel(std, sigma) < 0.015, "std {std} vs {sigma}");
+    for (k, p) in [(1.0, 0.682_689), (2.0, 0.954_500), (3.0, 0.997_300)] {
+        let inside = v
+            .iter()
+            .filter(|&&x| f64::from(x).abs() < k * sigma)
+            .count() as f64
+            / n;
+        // Binomial standard error √(p(1−p)/n), 5 of them.
+        let tol = 5.0 * (p * (1.0 - p) / n).sqrt();
+        assert!((inside - p).abs() < tol, "within {k} σ: {inside} vs {p}");
+    }
+}

@@ -71,9 +71,12 @@ pub fn expose_frame<C: FrameCapacity>(
                 });
             }
             for (s_row, o_row) in rows {
-                for ((o, &s), n) in o_row.iter_mut().zip(s_row).zip(field.next_row()) {
-                    *o = quantise(gain * s + offset + n);
-                }
+                let mut pixels = o_row.iter_mut().zip(s_row);
+                field.for_each_in_row(|n| {
+                    if let Some((o, &s)) = pixels.next() {
+                        *o = quantise(gain * s + offset + n);
+                    }
+                });
             }
         }
     }

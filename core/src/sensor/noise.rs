@@ -456,6 +456,45 @@ impl<C: FrameCapacity> NoiseField<C> {
     }
 }
 
+impl<C: FrameCapacity> NoiseField<C> {
+    /// The next row of noise, handed to `sink` one value in DN at a time, left to right
+    /// (`width` calls): the same values, draws and filter state as [`NoiseField::next_row`]
+    /// consumed to its end, bit for bit, on the flight path's fast loop (the generator's
+    /// state in registers, the first-row test taken once per row, the filter's state
+    /// row walked by an iterator: no per-pixel index check). `sink` is inlined.
+    #[inline]
+    pub fn for_each_in_row(&mut self, mut sink: impl FnMut(f32)) {
+        let first = self.rows == 0;
+        self.rows += 1;
+        let (alpha, innovation) = (self.alpha, self.innovation);
+        let (white_dn, flicker_dn) = (self.white_dn, self.flicker_dn);
+        let mut rng = self.rng.clone();
+        // Stationary start of the horizontal filter: h₋₁ ~ N(0, 1).
+        let mut h = standard_normal(&mut rng);
+        let column = self.column.as_mut().iter_mut().take(self.width);
+        if first {
+            for c in column {
+                let white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                h = alpha * h + innovation * g;
+                *c = h;
+                sink(white_dn * white + flicker_dn * h);
+            }
+        } else {
+            for c in column {
+                let white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                // x filter, then y filter; unit variance throughout.
+                h = alpha * h + innovation * g;
+                let z = alpha * *c + innovation * h;
+                *c = z;
+                sink(white_dn * white + flicker_dn * z);
+            }
+        }
+        self.rng = rng;
+    }
+}
+
 /// One row of a [`NoiseField`]: an iterator of `width` noise values in DN.
 #[derive(Debug)]
 pub struct NoiseRow<'a, C: FrameCapacity = Reference> {
