@@ -238,7 +238,12 @@ mod target {
     fn main() -> ! {
         // cortex-m-rt turns `static mut` items of the entry function into safe
         // `&'static mut` references: the buffers are statics, not on the stack. The
-        // frame is zeros (.bss); the scratch holds non-zero initial values (.data).
+        // frame, the detectors' one shared scratch area and the tables are all zero
+        // bytes (.bss: no initial values in flash). With `--features dtcm` the frame goes
+        // to AXI SRAM (memory-dtcm.x, NOLOAD: not cleared at start-up; the SPI link
+        // writes every pixel before anything reads one, and the emulator's RAM starts
+        // zeroed), everything else to the 128 KB DTCM.
+        #[cfg_attr(feature = "dtcm", unsafe(link_section = ".axisram.frame"))]
         static mut FRAME: [u16; FRAME_PIXELS] = [0; FRAME_PIXELS];
         static mut DETECTORS: Detectors = Detectors::new();
         static mut TABLES: Tables = Tables::new();
