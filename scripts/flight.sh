@@ -101,10 +101,15 @@ echo "flight: start-up budgets met (.data <= $DATA_BUDGET B, set-up <= $SETUP_BU
 DTCM_BUDGET=$((128 * 1024))
 AXISRAM_BUDGET=$((512 * 1024))
 echo "::: flight: ${targets[0]} --features dtcm (128 KiB DTCM map)"
+# Same target dir as the builds above (the core, its dependencies and build-std are
+# reused: only the firmware crate and the link run again); the ELF replaces the
+# ${targets[0]} one, whose run is done, so it is copied aside first.
+cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$out/${targets[0]}.elf"
 (cd firmware && RUSTC="$cross_rustc" RUSTC_BOOTSTRAP=1 "$cross_cargo" build --release --quiet \
-    --features dtcm --target "${targets[0]}" --target-dir "$fw_target_dir/dtcm" \
+    --features dtcm --target "${targets[0]}" --target-dir "$fw_target_dir" \
     -Zbuild-std=core -Zbuild-std-features=compiler-builtins-mem)
-dtcm_elf="$fw_target_dir/dtcm/${targets[0]}/release/tirroi-firmware"
+dtcm_elf="$out/${targets[0]}-dtcm.elf"
+cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$dtcm_elf"
 arm-none-eabi-size -A "$dtcm_elf" >"$out/dtcm.size"
 rc=0
 timeout 900 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -monitor none \
