@@ -71,12 +71,7 @@ pub fn expose_frame<C: FrameCapacity>(
                 });
             }
             for (s_row, o_row) in rows {
-                let mut pixels = o_row.iter_mut().zip(s_row);
-                field.for_each_in_row(|n| {
-                    if let Some((o, &s)) = pixels.next() {
-                        *o = quantise(gain * s + offset + n);
-                    }
-                });
+                field.combine_row(s_row, o_row, |s, n| quantise(gain * s + offset + n));
             }
         }
     }
