@@ -93,6 +93,14 @@ for target in "${targets[@]}"; do
         || die "$target: camera-model set-up took ${setup:-?} instructions > $SETUP_BUDGET (tables built at start-up?)"
 done
 echo "flight: start-up budgets met (.data <= $DATA_BUDGET B, set-up <= $SETUP_BUDGET instructions)"
+# The on-board DN + noise pass (table-driven: ziggurat draws, no libm on the common
+# path) at most DN_NOISE_BUDGET instructions per pixel on the flight target (the FPU
+# build; thumbv7m/thumbv6m do f32 in software and are only reported).
+DN_NOISE_BUDGET=100
+dn_noise=$(awk '$1 == "sensor" { for (i = 2; i <= NF; i++) if ($i ~ /^dn_noise_insns=/) { sub("dn_noise_insns=", "", $i); print $i } }' "$out/${targets[0]}.log")
+[[ -n $dn_noise && $dn_noise -le $((DN_NOISE_BUDGET * 328 * 248)) ]] \
+    || die "${targets[0]}: DN + noise took ${dn_noise:-?} instructions > $DN_NOISE_BUDGET per pixel"
+echo "flight: ${targets[0]}: DN + noise $dn_noise instructions, $((dn_noise / (328 * 248))) per pixel (budget $DN_NOISE_BUDGET)"
 
 # The STM32H7-class map (`--features dtcm`, firmware/memory-dtcm.x): statics (the one
 # shared scratch area) and stack in a 128 KiB DTCM, the frame in AXI SRAM. Built for
