@@ -437,6 +437,31 @@ mod tests {
     }
 
     #[test]
+    fn a_fresh_all_zero_builder_and_a_reused_one_agree() {
+        // A fresh builder holds zeros, not free entries: its first `start` frees the
+        // whole table. A frame with many components (every other pixel of every other
+        // row) fills the table; the next frame must come out as from a fresh builder.
+        let rows = ["#...#..##", "#...#..##", "#...#....", "#####...."];
+        let dots: [bool; 64] = core::array::from_fn(|x| x % 2 == 0);
+        for rule in [BoxRule::LargestComponent, BoxRule::AllForeground] {
+            let fresh = boxes(&rows, rule);
+            let mut b = RoiBuilder::new();
+            b.start(BoxRule::LargestComponent, 64);
+            for y in (0..40).step_by(2) {
+                b.push_row(y, &dots);
+            }
+            assert_eq!(b.finish(), (Some(Roi::new(0, 0, 1, 1)), 640));
+            b.start(rule, rows[0].len());
+            for (y, row) in rows.iter().enumerate() {
+                let mask: [bool; 64] =
+                    core::array::from_fn(|x| row.as_bytes().get(x) == Some(&b'#'));
+                b.push_row(y, &mask[..row.len()]);
+            }
+            assert_eq!(b.finish(), fresh, "{rule:?}");
+        }
+    }
+
+    #[test]
     fn u_shape_merges_late_into_one_component() {
         let rows = ["#...#..##", "#...#..##", "#...#....", "#####...."];
         assert_eq!(
