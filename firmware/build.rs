@@ -1,6 +1,7 @@
 //! Build script of the firmware demo:
-//! - puts the repository's `memory.x` (the flight target's memory map) where
-//!   cortex-m-rt's `link.x` finds it;
+//! - puts the repository's `memory.x` (the flight target's memory map; with
+//!   `--features dtcm` this crate's `memory-dtcm.x`) where cortex-m-rt's `link.x`
+//!   finds it;
 //! - decodes the frames of `frames/` (16-bit PNG, listed in `frames/truth.csv`) into
 //!   big-endian DN files in OUT_DIR and writes `frames.rs`, which embeds them in flash
 //!   with `include_bytes!`, in the order of `truth.csv`, with their truth boxes.
@@ -21,7 +22,13 @@ fn main() {
     let manifest =
         PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
 
-    let memory_x = manifest.join("../memory.x");
+    // `--features dtcm`: the STM32H7-class map (128 KB DTCM for statics and stack, the
+    // frame in AXI SRAM), else the reference flight part's (SAMV71Q21RT).
+    let memory_x = if env::var_os("CARGO_FEATURE_DTCM").is_some() {
+        manifest.join("memory-dtcm.x")
+    } else {
+        manifest.join("../memory.x")
+    };
     fs::copy(&memory_x, out.join("memory.x"))
         .unwrap_or_else(|e| panic!("cannot copy {}: {e}", memory_x.display()));
     println!("cargo:rustc-link-search={}", out.display());

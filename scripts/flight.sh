@@ -78,6 +78,65 @@ for target in "${targets[@]}"; do
     echo "flight: $target: built and ran in $((SECONDS - start)) s (exit $rc)"
 done
 
+# Nothing wasted at start-up, on every target: no scratch initial values in flash
+# (.data at most DATA_BUDGET bytes: the statics are zero bytes in .bss) and no table
+# built on board (the camera model's set-up at most SETUP_BUDGET instructions: the band
+# tables are build-time consts).
+DATA_BUDGET=4096
+SETUP_BUDGET=10000
+for target in "${targets[@]}"; do
+    data=$(awk '$1 == ".data" { print $2 }' "$out/$target.size")
+    [[ ${data:-0} -le $DATA_BUDGET ]] \
+        || die "$target: .data is $data B > $DATA_BUDGET B (initial values in flash: make the static zero bytes)"
+    setup=$(awk '$1 == "sensor" { for (i = 2; i <= NF; i++) if ($i ~ /^setup_insns=/) { sub("setup_insns=", "", $i); print $i } }' "$out/$target.log")
+    [[ -n $setup && $setup -le $SETUP_BUDGET ]] \
+        || die "$target: camera-model set-up took ${setup:-?} instructions > $SETUP_BUDGET (tables built at start-up?)"
+done
+echo "flight: start-up budgets met (.data <= $DATA_BUDGET B, set-up <= $SETUP_BUDGET instructions)"
+# The on-board DN + noise pass (table-driven: ziggurat draws, no libm on the common
+# path) at most DN_NOISE_BUDGET instructions per pixel on the flight target (the FPU
+# build; thumbv7m/thumbv6m do f32 in software and are only reported).
+DN_NOISE_BUDGET=100
+dn_noise=$(awk '$1 == "sensor" { for (i = 2; i <= NF; i++) if ($i ~ /^dn_noise_insns=/) { sub("dn_noise_insns=", "", $i); print $i } }' "$out/${targets[0]}.log")
+[[ -n $dn_noise && $dn_noise -le $((DN_NOISE_BUDGET * 328 * 248)) ]] \
+    || die "${targets[0]}: DN + noise took ${dn_noise:-?} instructions > $DN_NOISE_BUDGET per pixel"
+echo "flight: ${targets[0]}: DN + noise $dn_noise instructions, $((dn_noise / (328 * 248))) per pixel (budget $DN_NOISE_BUDGET)"
+
+# The STM32H7-class map (`--features dtcm`, firmware/memory-dtcm.x): statics (the one
+# shared scratch area) and stack in a 128 KiB DTCM, the frame in AXI SRAM. Built for
+# the flight target, run, its boxes and sensor checksum compared with the SAMV71
+# build's, and its DTCM and AXI SRAM budgets checked.
+DTCM_BUDGET=$((128 * 1024))
+AXISRAM_BUDGET=$((512 * 1024))
+echo "::: flight: ${targets[0]} --features dtcm (128 KiB DTCM map)"
+# Same target dir as the builds above (the core, its dependencies and build-std are
+# reused: only the firmware crate and the link run again); the ELF replaces the
+# ${targets[0]} one, whose run is done, so it is copied aside first.
+cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$out/${targets[0]}.elf"
+(cd firmware && RUSTC="$cross_rustc" RUSTC_BOOTSTRAP=1 "$cross_cargo" build --release --quiet \
+    --features dtcm --target "${targets[0]}" --target-dir "$fw_target_dir" \
+    -Zbuild-std=core -Zbuild-std-features=compiler-builtins-mem)
+dtcm_elf="$out/${targets[0]}-dtcm.elf"
+cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$dtcm_elf"
+arm-none-eabi-size -A "$dtcm_elf" >"$out/dtcm.size"
+rc=0
+timeout 900 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -monitor none \
+    -serial none -semihosting-config enable=on,target=native \
+    -icount shift=0,align=off,sleep=off -kernel "$dtcm_elf" >"$out/dtcm.log" || rc=$?
+[[ $rc -eq 0 ]] && grep -q '^done' "$out/dtcm.log" \
+    || die "the DTCM build failed on QEMU (exit $rc, see $out/dtcm.log)"
+strip_counts() { grep -E '^(detect|sensor)' "$1" | sed -E 's/ (insns|stack|[a-z]+_insns|[a-z]+_stack)=[^ ]*//g'; }
+diff <(strip_counts "$out/${targets[0]}.log") <(strip_counts "$out/dtcm.log") >/dev/null \
+    || die "the DTCM build's boxes or sensor checksum differ from the ${targets[0]} build's"
+dtcm_statics=$(awk '$1 == ".data" || $1 == ".bss" || $1 == ".uninit" { s += $2 } END { print s + 0 }' "$out/dtcm.size")
+dtcm_stack=$(awk '$1 == "ram" { for (i = 2; i <= NF; i++) if ($i ~ /^stack_peak=/) { sub("stack_peak=", "", $i); print $i } }' "$out/dtcm.log")
+axisram=$(awk '$1 == ".axisram" { print $2 }' "$out/dtcm.size")
+echo "flight: DTCM map: statics $dtcm_statics B + stack peak ${dtcm_stack:-?} B of $DTCM_BUDGET B DTCM; frame ${axisram:-0} B of $AXISRAM_BUDGET B AXI SRAM"
+[[ -n $dtcm_stack && $((dtcm_statics + dtcm_stack)) -le $DTCM_BUDGET ]] \
+    || die "DTCM budget exceeded: statics $dtcm_statics B + stack ${dtcm_stack:-?} B > $DTCM_BUDGET B"
+[[ ${axisram:-0} -gt 0 && $axisram -le $AXISRAM_BUDGET ]] \
+    || die "AXI SRAM: the frame section is ${axisram:-missing} B (budget $AXISRAM_BUDGET B)"
+
 # The defmt variant (`--features defmt`): built for the flight target, so the feature
 # cannot rot; its output is binary (decode with `defmt-print -e ELF`).
 echo "::: flight: ${targets[0]} --features defmt (build only)"

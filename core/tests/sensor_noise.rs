@@ -299,3 +299,71 @@ fn literal_noise_vanishes_in_quantisation_and_frames_saturate() {
     let mut narrow = NoiseField::new(loud, 4.0, 100, 9).unwrap();
     assert!(expose_frame(&signal, W, &m, Some(&mut narrow), &mut out).is_err());
 }
+
+/// The frame of [`field_frame`] through the flight path's loop
+/// ([`NoiseField::combine_row`], combining with a zero signal) instead of the row
+/// iterator.
+fn field_frame_fast(sigmas: NoiseSigmas, corr: f32, seed: u64) -> Vec<f32> {
+    let mut f = NoiseField::new(sigmas, corr, W, seed).unwrap();
+    let zero = [0.0f32; W];
+    let mut out = vec![f32::NAN; W * H];
+    for row in out.chunks_exact_mut(W) {
+        f.combine_row(&zero, row, |s, n| s + n);
+    }
+    out
+}
+
+#[test]
+fn flight_loop_is_the_row_iterator_bit_for_bit_with_normal_statistics() {
+    let s = NoiseSigmas {
+        johnson_dn: 3.0,
+        flicker_dn: 2.0,
+        thermal_dn: 1.0,
+    };
+    for (corr, seed) in [(DEFAULT_FLICKER_CORRELATION_PX, 7), (0.0, 8), (1.5, 2026)] {
+        let slow = field_frame(s, corr, seed);
+        let fast = field_frame_fast(s, corr, seed);
+        assert_eq!(fast.len(), W * H);
+        let same = slow
+            .iter()
+            .zip(&fast)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(
+            same,
+            "ℓ = {corr}, seed {seed}: the fast loop differs from next_row"
+        );
+        // Shorter signal rows: the dropped values are still drawn, so the next rows
+        // stay on the stream (row 2 of a field fed a 100-pixel row 1 equals next_row's).
+        let mut f = NoiseField::new(s, corr, W, seed).unwrap();
+        let mut short = vec![0.0f32; 100];
+        f.combine_row(&[0.0; 100], &mut short, |_, n| n);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&short), bits(&slow[..100]));
+        let mut row = vec![0.0f32; W];
+        f.combine_row(&[0.0; W], &mut row, |_, n| n);
+        assert_eq!(bits(&row), bits(&slow[W..2 * W]));
+    }
+    // White noise alone: mean 0, σ = √(σ_J² + σ_th²), and the share within 1, 2, 3 σ
+    // against the normal law's closed form erf(k/√2) = 0.682 689, 0.954 500, 0.997 300.
+    let white = NoiseSigmas {
+        johnson_dn: 4.0,
+        flicker_dn: 0.0,
+        thermal_dn: 3.0,
+    };
+    let v = field_frame_fast(white, DEFAULT_FLICKER_CORRELATION_PX, 11);
+    let n = v.len() as f64;
+    let sigma = 5.0;
+    let (mean, std) = mean_std(&v);
+    assert!(mean.abs() < 5.0 * sigma / n.sqrt(), "mean {mean}");
+    assert!(rel(std, sigma) < 0.015, "std {std} vs {sigma}");
+    for (k, p) in [(1.0, 0.682_689), (2.0, 0.954_500), (3.0, 0.997_300)] {
+        let inside = v
+            .iter()
+            .filter(|&&x| f64::from(x).abs() < k * sigma)
+            .count() as f64
+            / n;
+        // Binomial standard error √(p(1−p)/n), 5 of them.
+        let tol = 5.0 * (p * (1.0 - p) / n).sqrt();
+        assert!((inside - p).abs() < tol, "within {k} σ: {inside} vs {p}");
+    }
+}

@@ -546,14 +546,14 @@ fn fpu_table(md: &mut String, targets: &[Target], methods: &[String]) {
         ("camera model: band radiance from the table", |l| {
             Some(num(l, "radiance_insns")? as f64 / PIXELS)
         }),
-        ("camera model: DN map + noise", |l| {
-            Some((num(l, "expose_insns")? as f64 - num(l, "radiance_insns")? as f64) / PIXELS)
+        ("camera model: DN map + noise (the pass alone)", |l| {
+            Some(num(l, "dn_noise_insns")? as f64 / PIXELS)
         }),
         ("camera model: whole frame (radiance, DN, noise)", |l| {
             Some(num(l, "expose_insns")? as f64 / PIXELS)
         }),
         (
-            "camera model: set-up (quadrature + table, once), total M",
+            "camera model: set-up (build-time tables: pointers only), total M",
             |l| Some(num(l, "setup_insns")? as f64 / 1e6),
         ),
     ];

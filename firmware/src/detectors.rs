@@ -1,26 +1,84 @@
-//! Every detector of the core with its scratch memory, behind one call per method: the
-//! core's registry bank ([`tirroi_core::roi::Detectors`]) with default parameters.
+//! Every detector of the core behind one call per method, with default parameters, in
+//! ONE scratch area shared by all of them ([`SharedScratch`]): only one detector runs at
+//! a time, so the demo needs the largest scratch (DoG's, 74 KB), not the sum of all
+//! five (141 KB, the core's registry bank [`tirroi_core::roi::Detectors`]).
 
-use tirroi_core::roi::auto::Auto;
-use tirroi_core::roi::{self, Params};
+use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
+use tirroi_core::roi::auto::{Auto, AutoScratch};
+use tirroi_core::roi::dog::{Dog, DogScratch};
+use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
+use tirroi_core::roi::wge::{Wge, WgeScratch};
+use tirroi_core::roi::{Detector, Scratch};
 use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
 
 /// The methods the demo runs on every frame, in the core's order.
 pub const DEMO_METHODS: &[Method] = &Method::ALL;
 
+/// The one scratch area of the demo: idle, or the scratch of the detector that ran
+/// last. A fresh one is [`SharedScratch::Idle`], discriminant 0 and nothing else, so a
+/// `static` of it is zero bytes in `.bss` (no initial values in flash). Switching to
+/// another detector writes that detector's fresh scratch over the area (a memset
+/// where its fresh scratch is all zeros; `auto`'s keeps a few non-zero sentinels,
+/// written from a constant in flash). Detectors keep no state between calls, so a
+/// fresh scratch gives the same box as a reused one (the flight report compares every
+/// box with the host's `tirroi detect`).
+// repr(u8): an explicit tag byte, 0 for `Idle`, so the idle area is all zero bytes
+// (without it rustc may encode `Idle` in a niche of a scratch field, a non-zero byte
+// that moves the whole 74 KB to `.data`).
+#[allow(clippy::large_enum_variant)] // one area the size of the largest, on purpose
+#[repr(u8)]
+pub enum SharedScratch {
+    /// No detector has run yet.
+    Idle,
+    /// [`Otsu`]'s scratch.
+    Otsu(OtsuScratch),
+    /// [`Adaptive`]'s scratch.
+    Adaptive(AdaptiveScratch),
+    /// [`Wge`]'s scratch.
+    Wge(WgeScratch),
+    /// [`Dog`]'s scratch.
+    Dog(DogScratch),
+    /// [`Auto`]'s scratch.
+    Auto(AutoScratch),
+}
+
+/// Runs detector `$params` in the `$Variant` of a [`SharedScratch`], switching the area
+/// over to it first when another detector used it last.
+macro_rules! run_in {
+    ($shared:expr, $Variant:ident, $params:expr, $frame:expr) => {{
+        let shared: &mut SharedScratch = $shared;
+        if !matches!(shared, SharedScratch::$Variant(_)) {
+            *shared = SharedScratch::$Variant(Scratch::new());
+        }
+        match shared {
+            SharedScratch::$Variant(scratch) => Detector::detect(&$params, $frame, scratch),
+            // Just switched over above.
+            _ => Err(DetectError::InvalidParameter {
+                name: "scratch",
+                expected: "the shared area switched to the detector",
+            }),
+        }
+    }};
+}
+
 /// The detectors with their default parameters (what `tirroi detect` runs on the host,
-/// so the boxes can be compared bit for bit) and each one's scratch memory.
+/// so the boxes can be compared bit for bit) and the one scratch area they share.
 pub struct Detectors {
-    bank: roi::Detectors,
+    shared: SharedScratch,
 }
 
 impl Detectors {
-    /// Fresh scratch for every detector (a `const fn`: the whole struct can be a
-    /// `static`).
+    /// An idle scratch area (a `const fn` of zero bytes: the whole struct can be a
+    /// `static` in `.bss`).
     pub const fn new() -> Self {
         Detectors {
-            bank: roi::Detectors::new(),
+            shared: SharedScratch::Idle,
         }
+    }
+
+    /// Bytes of the shared scratch area (the largest detector's scratch and the tag).
+    pub const fn scratch_bytes() -> usize {
+        core::mem::size_of::<SharedScratch>()
     }
 
     /// Runs `method` with its default parameters on `frame`.
@@ -33,11 +91,16 @@ impl Detectors {
     /// tests).
     #[inline(never)]
     pub fn run(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        self.bank.detect_default(method, frame)
+        let shared = &mut self.shared;
+        match method {
+            Method::Otsu => run_in!(shared, Otsu, Otsu::default(), frame),
+            Method::Adaptive => run_in!(shared, Adaptive, Adaptive::default(), frame),
+            Method::Wge => run_in!(shared, Wge, Wge::default(), frame),
+            Method::Dog => run_in!(shared, Dog, Dog::default(), frame),
+            Method::Auto => run_in!(shared, Auto, Auto::default(), frame),
+        }
     }
-}
 
-impl Detectors {
     /// Runs `auto` in tracking mode: only a window around `prior` (the last frame's
     /// box) is processed, the whole frame only when the target is lost there.
     ///
@@ -47,8 +110,8 @@ impl Detectors {
     /// [`DetectError`] when the default parameters are refused (never).
     #[inline(never)]
     pub fn track(&mut self, prior: Roi, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        let params = Params::Auto(Auto::default().with_prior(Some(prior)));
-        self.bank.detect(&params, frame)
+        let params = Auto::default().with_prior(Some(prior));
+        run_in!(&mut self.shared, Auto, params, frame)
     }
 }
 

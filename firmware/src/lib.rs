@@ -119,7 +119,8 @@ pub fn run_demo<M: Meter>(ws: &mut Workspace<'_>, meter: &mut M, emit: &mut dyn 
         detect_all(ws, embedded.name, Some(embedded.truth), meter, emit);
     }
 
-    // The camera model on board: tables, then a frame of radiance → DN + noise.
+    // The camera model on board: tables, the radiance and the DN + noise passes alone
+    // (to count each), then a frame of radiance → DN + noise.
     meter.start();
     synth::setup(ws);
     let setup = meter.stop();
@@ -127,14 +128,18 @@ pub fn run_demo<M: Meter>(ws: &mut Workspace<'_>, meter: &mut M, emit: &mut dyn 
     let radiance = black_box(synth::radiance_only(ws));
     let radiance_meter = meter.stop();
     meter.start();
+    let dn_noise = black_box(synth::dn_noise_only(ws));
+    let dn_noise_meter = meter.stop();
+    meter.start();
     let made = black_box(synth::expose_scene(ws));
     let expose = meter.stop();
-    match made.and(radiance) {
+    match made.and(radiance).and(dn_noise) {
         Ok(()) => {
             emit(&Event::Sensor {
                 checksum: synth::checksum(&ws.frame[..]),
                 setup,
                 radiance: radiance_meter,
+                dn_noise: dn_noise_meter,
                 expose,
             });
             detect_all(ws, synth::NAME, None, meter, emit);

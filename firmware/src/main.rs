@@ -234,12 +234,29 @@ mod target {
         );
     }
 
+    /// The one frame buffer (162 688 B), zero bytes in `.bss`; with `--features dtcm`
+    /// in AXI SRAM (memory-dtcm.x's `.axisram`, NOLOAD: not cleared at start-up; the
+    /// SPI link writes every pixel before anything reads one, and the emulator's RAM
+    /// starts zeroed). A module-level static because the entry function's `static mut`
+    /// items (turned into parameters by cortex-m-rt) cannot take `#[link_section]`.
+    #[cfg_attr(feature = "dtcm", unsafe(link_section = ".axisram.frame"))]
+    static mut FRAME: [u16; FRAME_PIXELS] = [0; FRAME_PIXELS];
+
+    /// The frame buffer, borrowed once for the whole program.
+    fn frame_buffer() -> &'static mut [u16; FRAME_PIXELS] {
+        // SAFETY: called exactly once, from `main` before the demo starts (nothing else
+        // names FRAME), so this is the only reference to the buffer ever made; no
+        // interrupt handler touches it. Needed because a section attribute (the DTCM
+        // map's frame in AXI SRAM) needs a module-level static.
+        unsafe { &mut *(&raw mut FRAME) }
+    }
+
     #[entry]
     fn main() -> ! {
         // cortex-m-rt turns `static mut` items of the entry function into safe
         // `&'static mut` references: the buffers are statics, not on the stack. The
-        // frame is zeros (.bss); the scratch holds non-zero initial values (.data).
-        static mut FRAME: [u16; FRAME_PIXELS] = [0; FRAME_PIXELS];
+        // detectors' one shared scratch area and the tables are zero bytes (.bss: no
+        // initial values in flash); the frame is the module-level `FRAME` below.
         static mut DETECTORS: Detectors = Detectors::new();
         static mut TABLES: Tables = Tables::new();
 
@@ -256,7 +273,7 @@ mod target {
 
         let mut failed = false;
         let mut workspace = Workspace {
-            frame: FRAME,
+            frame: frame_buffer(),
             detectors: DETECTORS,
             tables: TABLES,
         };

@@ -67,6 +67,8 @@ pub enum Event {
         setup: MeterReading,
         /// Band radiance of every pixel from the table (the first stage of `expose`).
         radiance: MeterReading,
+        /// The DN map + noise pass alone over a frame (the second stage of `expose`).
+        dn_noise: MeterReading,
         /// Radiance, DN and noise for the whole frame.
         expose: MeterReading,
     },
@@ -158,13 +160,15 @@ impl fmt::Display for Event {
                 checksum,
                 setup,
                 radiance,
+                dn_noise,
                 expose,
             } => write!(
                 f,
-                "sensor checksum={checksum:016x} setup_insns={} setup_stack={} radiance_insns={} expose_insns={} expose_stack={}",
+                "sensor checksum={checksum:016x} setup_insns={} setup_stack={} radiance_insns={} dn_noise_insns={} expose_insns={} expose_stack={}",
                 Opt(setup.instructions),
                 Opt(setup.stack_bytes),
                 Opt(radiance.instructions),
+                Opt(dn_noise.instructions),
                 Opt(expose.instructions),
                 Opt(expose.stack_bytes)
             ),
@@ -241,13 +245,15 @@ impl defmt::Format for Event {
                 checksum,
                 setup,
                 radiance,
+                dn_noise,
                 expose,
             } => defmt::write!(
                 f,
-                "sensor checksum={=u64:x} setup={} radiance={} expose={}",
+                "sensor checksum={=u64:x} setup={} radiance={} dn_noise={} expose={}",
                 checksum,
                 setup,
                 radiance,
+                dn_noise,
                 expose
             ),
             Event::Error { frame, what } => {

@@ -18,12 +18,15 @@ use tirroi_core::sensor::{
 
 use crate::{BITS, Workspace};
 
-/// The camera model's tables: band radiance (170-node quadrature, 5.9 KB) and its fast
-/// table (11.3 KB), built on board by [`setup`].
+/// The camera model's tables: band radiance (160-node quadrature, 5.9 KB) and its fast
+/// table (11.3 KB). Both are `const`s computed at build time
+/// ([`BandRadiance::HAYABUSA2_TIR`], [`BandLut::HAYABUSA2_TIR`], in flash); [`setup`]
+/// only points at them, so start-up computes nothing (it built them on board before:
+/// 710 M instructions and 30 KB of stack on the Cortex-M7).
 #[derive(Default)]
 pub struct Tables {
-    band: Option<BandRadiance>,
-    lut: Option<BandLut>,
+    band: Option<&'static BandRadiance>,
+    lut: Option<&'static BandLut>,
 }
 
 impl Tables {
@@ -64,19 +67,18 @@ fn scene(x: usize, y: usize) -> (f32, f32) {
     }
 }
 
-/// Builds the camera's band radiance (160-node quadrature of ε·B(λ,T)·R(λ) over the
-/// measured Hayabusa2 TIR response) and its fast table, once, into the workspace. Never
-/// inlined, so that its stack is measured as its own.
+/// Points the workspace at the camera's band radiance (160-node quadrature of
+/// ε·B(λ,T)·R(λ) over the measured Hayabusa2 TIR response) and its fast table, both
+/// computed at build time. Never inlined, so that its cost is measured as its own.
 #[inline(never)]
 pub fn setup(ws: &mut Workspace<'_>) {
-    let tables = &mut *ws.tables;
-    let band = tables.band.insert(BandRadiance::hayabusa2_tir());
-    tables.lut = Some(BandLut::new(band));
+    ws.tables.band = Some(&BandRadiance::HAYABUSA2_TIR);
+    ws.tables.lut = Some(&BandLut::HAYABUSA2_TIR);
 }
 
 /// The tables, or the error of a missing [`setup`].
-fn tables(tables: &Tables) -> Result<(&BandRadiance, &BandLut), SensorError> {
-    match (tables.band.as_ref(), tables.lut.as_ref()) {
+fn tables(tables: &Tables) -> Result<(&'static BandRadiance, &'static BandLut), SensorError> {
+    match (tables.band, tables.lut) {
         (Some(band), Some(lut)) => Ok((band, lut)),
         _ => Err(SensorError::NotFinite {
             name: "band tables (run synth::setup)",
@@ -102,6 +104,46 @@ pub fn radiance_only(ws: &mut Workspace<'_>) -> Result<(), SensorError> {
     Ok(())
 }
 
+/// The DN map + noise pass alone ([`expose_frame`] with the noise field, as in
+/// [`expose_scene`]) over a whole frame, on one row of signal computed once (the
+/// scene's middle row; the pass costs the same for any finite signal), into
+/// `ws.frame`: the cost of DN + noise per pixel, measured directly. [`setup`] must have
+/// run. Never inlined, so that its cost is measured as its own.
+///
+/// # Errors
+/// [`SensorError`] when the tables are missing or the model refuses its input.
+#[inline(never)]
+pub fn dn_noise_only(ws: &mut Workspace<'_>) -> Result<(), SensorError> {
+    let (band, lut) = tables(ws.tables)?;
+    let (mapping, mut noise) = dn_map_and_noise(band, lut)?;
+    let mut signal = [0.0f32; FRAME_WIDTH];
+    for (x, s) in signal.iter_mut().enumerate() {
+        *s = emissive_power(lut, scene(x, FRAME_HEIGHT / 2))?;
+    }
+    for out in ws.frame.chunks_exact_mut(FRAME_WIDTH) {
+        expose_frame(&signal, FRAME_WIDTH, &mapping, Some(&mut noise), out)?;
+    }
+    Ok(())
+}
+
+/// The Eq. 17 DN map of the scene's range and the seeded noise field at the TIR's NETD.
+fn dn_map_and_noise(
+    band: &BandRadiance,
+    lut: &BandLut,
+) -> Result<(DnMapping, NoiseField), SensorError> {
+    let f_min = emissive_power(lut, COLDEST)?;
+    let f_max = emissive_power(lut, WARMEST)?;
+    let mapping = DnMapping::radiometry_auto(f64::from(f_min), f64::from(f_max), BITS)?;
+    let dn_per_k = mapping.dn_per_kelvin(band, 300.0, core::f64::consts::PI)?;
+    let sigmas = NoiseLevel::Netd {
+        netd_k: NETD_K,
+        dn_per_k,
+    }
+    .sigmas(&NoiseRms::TABLE2, &mapping)?;
+    let noise = NoiseField::new(sigmas, FLICKER_CORRELATION_PX, FRAME_WIDTH, SEED)?;
+    Ok((mapping, noise))
+}
+
 /// Emissive power F = π·ε·L(T), W m⁻², from the table.
 fn emissive_power(lut: &BandLut, (t_k, emissivity): (f32, f32)) -> Result<f32, SensorError> {
     Ok(core::f32::consts::PI * lut.radiance_f32(t_k, emissivity)?)
@@ -115,16 +157,7 @@ fn emissive_power(lut: &BandLut, (t_k, emissivity): (f32, f32)) -> Result<f32, S
 #[inline(never)]
 pub fn expose_scene(ws: &mut Workspace<'_>) -> Result<(), SensorError> {
     let (band, lut) = tables(ws.tables)?;
-    let f_min = emissive_power(lut, COLDEST)?;
-    let f_max = emissive_power(lut, WARMEST)?;
-    let mapping = DnMapping::radiometry_auto(f64::from(f_min), f64::from(f_max), BITS)?;
-    let dn_per_k = mapping.dn_per_kelvin(band, 300.0, core::f64::consts::PI)?;
-    let sigmas = NoiseLevel::Netd {
-        netd_k: NETD_K,
-        dn_per_k,
-    }
-    .sigmas(&NoiseRms::TABLE2, &mapping)?;
-    let mut noise = NoiseField::new(sigmas, FLICKER_CORRELATION_PX, FRAME_WIDTH, SEED)?;
+    let (mapping, mut noise) = dn_map_and_noise(band, lut)?;
     let mut signal = [0.0f32; FRAME_WIDTH];
     for (y, out) in ws.frame.chunks_exact_mut(FRAME_WIDTH).enumerate() {
         for (x, s) in signal.iter_mut().enumerate() {

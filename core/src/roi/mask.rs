@@ -17,8 +17,10 @@ use super::components::{Components, Label, Stats};
 use super::{BoxRule, Roi};
 use crate::capacity::{ConstInit, FrameCapacity, Reference};
 
-/// A component label of the run table (`u16`; [`FREE`] marks a free entry, and is
-/// what a fresh table holds).
+/// A component label of the run table (`u16`; [`FREE`] marks a free entry). A fresh
+/// table holds zeros (so a builder in a `static` is all zero bytes and lands in `.bss`,
+/// with no initial values in flash); [`RoiBuilder::start`] frees every entry before
+/// its first frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct RunLabel(u16);
 
@@ -30,7 +32,8 @@ impl Label for RunLabel {
 }
 
 impl ConstInit for RunLabel {
-    const INIT: Self = FREE;
+    /// Zero bytes: not yet a free entry ([`RoiBuilder::start`] frees it).
+    const INIT: Self = RunLabel(0);
 }
 
 /// Marks a free component-table entry (as its parent, outside the table).
@@ -45,14 +48,13 @@ struct Run {
 }
 
 impl ConstInit for Run {
-    const INIT: Self = NO_RUN;
+    /// Zero bytes: runs are only read below the row's run count, after being written.
+    const INIT: Self = Run {
+        x0: 0,
+        x1: 0,
+        label: RunLabel(0),
+    };
 }
-
-const NO_RUN: Run = Run {
-    x0: 0,
-    x1: 0,
-    label: FREE,
-};
 
 /// Statistics of one (partial) component of foreground pixels.
 #[derive(Debug, Clone, Copy)]
@@ -72,7 +74,12 @@ const NO_PIXELS: RunStats = RunStats {
 };
 
 impl ConstInit for RunStats {
-    const INIT: Self = NO_PIXELS;
+    /// Zero bytes: replaced by [`NO_PIXELS`] when [`RoiBuilder::start`] frees the entry.
+    const INIT: Self = RunStats {
+        roi: Roi::EMPTY,
+        area: 0,
+        first: 0,
+    };
 }
 
 impl RunStats {
@@ -129,6 +136,9 @@ pub struct RoiBuilder<C: FrameCapacity = Reference> {
     table_high: usize,
     /// The largest complete component so far.
     best: Option<RunStats>,
+    /// False until the first [`RoiBuilder::start`] has freed the whole table (a fresh
+    /// builder is all zeros, see [`RunLabel`]).
+    cleared: bool,
 }
 
 impl<C: FrameCapacity> Default for RoiBuilder<C> {
@@ -162,6 +172,7 @@ impl<C: FrameCapacity> RoiBuilder<C> {
             seen_row: ConstInit::INIT,
             table_high: 0,
             best: None,
+            cleared: false,
         }
     }
 
@@ -175,9 +186,16 @@ impl<C: FrameCapacity> RoiBuilder<C> {
         self.hull = Roi::EMPTY;
         self.prev_len = 0;
         self.cur_len = 0;
-        for k in 0..self.table_high {
+        // Entries at and above `table_high` are free once the table has been cleared.
+        let used = if self.cleared {
+            self.table_high
+        } else {
+            self.table.parents().as_ref().len()
+        };
+        for k in 0..used {
             self.free(k);
         }
+        self.cleared = true;
         self.table_high = 0;
         self.best = None;
     }
@@ -441,6 +459,31 @@ mod tests {
             b.push_row(y, &mask[..row.len()]);
         }
         b.finish()
+    }
+
+    #[test]
+    fn a_fresh_all_zero_builder_and_a_reused_one_agree() {
+        // A fresh builder holds zeros, not free entries: its first `start` frees the
+        // whole table. A frame with many components (every other pixel of every other
+        // row) fills the table; the next frame must come out as from a fresh builder.
+        let rows = ["#...#..##", "#...#..##", "#...#....", "#####...."];
+        let dots: [bool; 64] = core::array::from_fn(|x| x % 2 == 0);
+        for rule in [BoxRule::LargestComponent, BoxRule::AllForeground] {
+            let fresh = boxes(&rows, rule);
+            let mut b = RoiBuilder::new();
+            b.start(BoxRule::LargestComponent, 64);
+            for y in (0..40).step_by(2) {
+                b.push_row(y, &dots);
+            }
+            assert_eq!(b.finish(), (Some(Roi::new(0, 0, 1, 1)), 640));
+            b.start(rule, rows[0].len());
+            for (y, row) in rows.iter().enumerate() {
+                let mask: [bool; 64] =
+                    core::array::from_fn(|x| row.as_bytes().get(x) == Some(&b'#'));
+                b.push_row(y, &mask[..row.len()]);
+            }
+            assert_eq!(b.finish(), fresh, "{rule:?}");
+        }
     }
 
     #[test]

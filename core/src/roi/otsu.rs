@@ -64,7 +64,9 @@ impl<C: FrameCapacity> ConstInit for OtsuWork<C> {
     const INIT: Self = OtsuWork {
         coarse: [[0; COARSE_BINS]; LANES],
         fine: [[ConstInit::INIT; FINE_SLOTS]; 2],
-        slot: [NOT_REFINED; COARSE_BINS],
+        // Zero bytes (a `static` scratch lands in `.bss`): every call fills `slot` with
+        // NOT_REFINED before reading it.
+        slot: [0; COARSE_BINS],
         mask: ConstInit::INIT,
     };
 }

@@ -51,7 +51,66 @@ pub struct BandLut {
     intervals: [Interval; LUT_INTERVALS],
 }
 
+/// Fields of one [`Interval`] in the generated tables of [`super::band_tables`]:
+/// T_i, 1/width, ln L_i, L_i, L_i+1, Δln L, slope₀, slope₁ (f32 bit patterns).
+pub(super) const INTERVAL_FIELDS: usize = 8;
+
 impl BandLut {
+    /// The table of the Hayabusa2 TIR camera's measured response as a `const`:
+    /// `BandLut::new(&BandRadiance::hayabusa2_tir())` computed at build time (the
+    /// generated [`super::band_tables`], checked against the run-time code bit for
+    /// bit). Nothing to compute at start-up (on the Cortex-M7 the run-time build costs
+    /// about 664 M instructions of soft f64).
+    pub const HAYABUSA2_TIR: BandLut = BandLut::from_bits(&super::band_tables::TIR_LUT_BITS);
+
+    /// A table from its intervals' f32 bit patterns (field order of [`INTERVAL_FIELDS`]).
+    const fn from_bits(bits: &[[u32; INTERVAL_FIELDS]; LUT_INTERVALS]) -> Self {
+        let zero = Interval {
+            t_k: 0.0,
+            inv_width_k: 0.0,
+            ln_l: 0.0,
+            l: 0.0,
+            l_next: 0.0,
+            dln_l: 0.0,
+            slope0: 0.0,
+            slope1: 0.0,
+        };
+        let mut intervals = [zero; LUT_INTERVALS];
+        let mut i = 0;
+        while i < LUT_INTERVALS {
+            let b = &bits[i];
+            intervals[i] = Interval {
+                t_k: f32::from_bits(b[0]),
+                inv_width_k: f32::from_bits(b[1]),
+                ln_l: f32::from_bits(b[2]),
+                l: f32::from_bits(b[3]),
+                l_next: f32::from_bits(b[4]),
+                dln_l: f32::from_bits(b[5]),
+                slope0: f32::from_bits(b[6]),
+                slope1: f32::from_bits(b[7]),
+            };
+            i += 1;
+        }
+        BandLut { intervals }
+    }
+
+    /// The intervals' f32 bit patterns (for the generator of [`super::band_tables`]).
+    #[cfg(test)]
+    pub(super) fn interval_bits(&self) -> impl Iterator<Item = [u32; INTERVAL_FIELDS]> + '_ {
+        self.intervals.iter().map(|iv| {
+            [
+                iv.t_k.to_bits(),
+                iv.inv_width_k.to_bits(),
+                iv.ln_l.to_bits(),
+                iv.l.to_bits(),
+                iv.l_next.to_bits(),
+                iv.dln_l.to_bits(),
+                iv.slope0.to_bits(),
+                iv.slope1.to_bits(),
+            ]
+        })
+    }
+
     /// Tabulates `band` (about 700 exact evaluations: 2 ms on the host, done once).
     pub fn new(band: &BandRadiance) -> Self {
         let mut intervals = [Interval::default(); LUT_INTERVALS];

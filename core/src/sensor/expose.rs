@@ -71,9 +71,7 @@ pub fn expose_frame<C: FrameCapacity>(
                 });
             }
             for (s_row, o_row) in rows {
-                for ((o, &s), n) in o_row.iter_mut().zip(s_row).zip(field.next_row()) {
-                    *o = quantise(gain * s + offset + n);
-                }
+                field.combine_row(s_row, o_row, |s, n| quantise(gain * s + offset + n));
             }
         }
     }

@@ -68,7 +68,10 @@ pub fn standard_normal(rng: &mut Xoshiro128pp) -> f32 {
         // Strip and sign index the signed width: x = ±u·xᵢ/2²⁴ in one multiply.
         return u as f32 * SIGNED_WIDTH_PER_UNIT[(bits & SIGNED_LAYER_MASK) as usize];
     }
-    let magnitude = slow_path(rng, layer, u);
+    // The generator goes to the cold path by value and comes back: its address never
+    // escapes, so the caller's loop keeps its 16 bytes of state in registers.
+    let (magnitude, state) = slow_path(rng.clone(), layer, u);
+    *rng = state;
     f32::from_bits(magnitude.to_bits() | ((bits & SIGN_BIT) << SIGN_SHIFT))
 }
 
@@ -78,9 +81,16 @@ fn uniform_open0(rng: &mut Xoshiro128pp) -> f32 {
     ((rng.next_u32() >> UNIFORM_SHIFT) + 1) as f32 * TWO_POW_M24
 }
 
-/// The tail and wedge tests (2.8 % of draws), looping on rejection; returns |x|.
+/// The tail and wedge tests (2.8 % of draws), looping on rejection; returns |x| and
+/// the generator's new state.
 #[cold]
-fn slow_path(rng: &mut Xoshiro128pp, mut layer: usize, mut u: u32) -> f32 {
+fn slow_path(mut state: Xoshiro128pp, layer: usize, u: u32) -> (f32, Xoshiro128pp) {
+    let magnitude = slow_magnitude(&mut state, layer, u);
+    (magnitude, state)
+}
+
+/// The rejection loop of [`slow_path`]; returns |x|.
+fn slow_magnitude(rng: &mut Xoshiro128pp, mut layer: usize, mut u: u32) -> f32 {
     loop {
         if layer == 0 {
             // Marsaglia's tail: x − r ~ Exp(r) accepted with probability e^(−(x−r)²/2).

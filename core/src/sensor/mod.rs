@@ -24,6 +24,12 @@
 //! panics.
 
 pub mod band_lut;
+// Generated tables (the `const` band radiance and fast table); not reformatted, so the
+// test in `band_tables_check` can compare the file with its generator's text.
+#[rustfmt::skip]
+mod band_tables;
+#[cfg(test)]
+mod band_tables_check;
 pub mod dn;
 pub mod expose;
 pub mod flux;

@@ -456,6 +456,74 @@ impl<C: FrameCapacity> NoiseField<C> {
     }
 }
 
+impl<C: FrameCapacity> NoiseField<C> {
+    /// Combines the next row of noise with a row of `signal` into `out`, left to
+    /// right: `out[x] = combine(signal[x], noise[x])`, the noise in DN being the same
+    /// values, draws and filter state as [`NoiseField::next_row`] consumed to its end,
+    /// bit for bit. The row is drawn in full (`width` values) even when `signal` or
+    /// `out` is shorter, so the stream stays aligned; values past the shorter of the
+    /// two are dropped. The flight path's fast loop: the generator's 16 bytes of state
+    /// in registers, the first-row test once per row, the filter's state row, the
+    /// signal and the output walked together by one zip (no per-pixel index check).
+    #[inline]
+    pub fn combine_row<T>(
+        &mut self,
+        signal: &[f32],
+        out: &mut [T],
+        mut combine: impl FnMut(f32, f32) -> T,
+    ) {
+        let first = self.rows == 0;
+        self.rows += 1;
+        let (alpha, innovation) = (self.alpha, self.innovation);
+        let (white_dn, flicker_dn) = (self.white_dn, self.flicker_dn);
+        let mut rng = self.rng.clone();
+        // Stationary start of the horizontal filter: h₋₁ ~ N(0, 1).
+        let mut h = standard_normal(&mut rng);
+        // The filter's state: `width` columns, those with a signal and an output, then
+        // the rest (checked-once splits: no panic path).
+        let column = self.column.as_mut();
+        let (column, _) = column.split_at_mut_checked(self.width).unwrap_or_default();
+        let paired = signal.len().min(out.len());
+        let (head, rest) = match column.split_at_mut_checked(paired) {
+            Some(split) => split,
+            None => (column, &mut [][..]),
+        };
+        let pixels = head.iter_mut().zip(signal).zip(out.iter_mut());
+        if first {
+            for ((c, &s), o) in pixels {
+                let white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                h = alpha * h + innovation * g;
+                *c = h;
+                *o = combine(s, white_dn * white + flicker_dn * h);
+            }
+            for c in rest {
+                let _white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                h = alpha * h + innovation * g;
+                *c = h;
+            }
+        } else {
+            for ((c, &s), o) in pixels {
+                let white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                // x filter, then y filter; unit variance throughout.
+                h = alpha * h + innovation * g;
+                let z = alpha * *c + innovation * h;
+                *c = z;
+                *o = combine(s, white_dn * white + flicker_dn * z);
+            }
+            for c in rest {
+                let _white = standard_normal(&mut rng);
+                let g = standard_normal(&mut rng);
+                h = alpha * h + innovation * g;
+                *c = alpha * *c + innovation * h;
+            }
+        }
+        self.rng = rng;
+    }
+}
+
 /// One row of a [`NoiseField`]: an iterator of `width` noise values in DN.
 #[derive(Debug)]
 pub struct NoiseRow<'a, C: FrameCapacity = Reference> {
