@@ -114,7 +114,7 @@ echo "::: flight: ${targets[0]} --features dtcm (128 KiB DTCM map)"
 # ${targets[0]} one, whose run is done, so it is copied aside first.
 cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$out/${targets[0]}.elf"
 (cd firmware && RUSTC="$cross_rustc" RUSTC_BOOTSTRAP=1 "$cross_cargo" build --release --quiet \
-    --features dtcm --target "${targets[0]}" --target-dir "$fw_target_dir" \
+    --features dtcm --bin tirroi-firmware --target "${targets[0]}" --target-dir "$fw_target_dir" \
     -Zbuild-std=core -Zbuild-std-features=compiler-builtins-mem)
 dtcm_elf="$out/${targets[0]}-dtcm.elf"
 cp "$fw_target_dir/${targets[0]}/release/tirroi-firmware" "$dtcm_elf"
