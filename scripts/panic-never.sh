@@ -23,8 +23,8 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 
-REQUIRED=(otsu adaptive wge dog)
-PENDING=(auto auto-prior sensor)
+REQUIRED=(otsu adaptive wge dog auto auto-prior)
+PENDING=(sensor)
 
 if [[ $# -gt 0 ]]; then
     REQUIRED=("$@")
@@ -100,5 +100,6 @@ if [[ ${#failed[@]} -gt 0 ]]; then
     die "panic paths in required components: ${failed[*]}"
 fi
 if [[ $required_ok -eq 0 ]] && ! build "$required"; then
+    sites "$required" || true
     die "the required set (${REQUIRED[*]}) has a panic path no single component has (see above)"
 fi

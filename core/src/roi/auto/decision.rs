@@ -25,7 +25,7 @@ pub(super) fn choose_target(
     let mut best: Option<(u8, u64)> = None;
     #[allow(clippy::needless_range_loop)] // `l` is the label: parent and statistics
     for l in 1..next {
-        if parent[l] != l as u8 {
+        if parent.get(l) != Some(&(l as u8)) {
             continue;
         }
         let Some(c) = comps.stats(l) else { continue };

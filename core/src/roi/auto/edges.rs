@@ -122,9 +122,13 @@ fn label_edges(
 ) -> Option<usize> {
     let mut next = 1usize;
     let mut overflow = false;
-    for (cy, steps) in step.chunks_exact(pw).enumerate() {
-        let (before, rest) = plane.split_at_mut(cy * pw);
-        let cur = &mut rest[..pw];
+    for (cy, steps) in step.chunks_exact(pw.max(1)).enumerate() {
+        let Some((before, rest)) = plane.split_at_mut_checked(cy * pw) else {
+            break;
+        };
+        let Some(cur) = rest.get_mut(..pw) else {
+            break;
+        };
         cur.fill(0);
         if steps.iter().all(|&q| q < threshold) {
             continue;
@@ -135,7 +139,11 @@ fn label_edges(
             if q < threshold {
                 continue;
             }
-            let left = if cx > 0 { cur[cx - 1] } else { 0 };
+            let left = cx
+                .checked_sub(1)
+                .and_then(|i| cur.get(i))
+                .copied()
+                .unwrap_or(0);
             let up_left = if cx > 0 { up(cx - 1) } else { 0 };
             let mut l = 0u8;
             for m in [left, up_left, up(cx), up(cx + 1)] {
@@ -158,7 +166,9 @@ fn label_edges(
                 comps.make_set(l, NO_CELLS);
                 next += 1;
             }
-            cur[cx] = l;
+            if let Some(c) = cur.get_mut(cx) {
+                *c = l;
+            }
             if let Some(c) = comps.stats_mut(usize::from(l)) {
                 c.add(cx as u8, cy as u8, step_value(q));
             }

@@ -228,10 +228,13 @@ impl Auto {
             flag_row,
         } = work;
         let plane = (win.w.div_ceil(BLOCK), win.h.div_ceil(BLOCK));
-        let (step_codes, labels) = (
-            &mut step_codes.as_mut()[..plane.0 * plane.1],
-            &mut labels.as_mut()[..plane.0 * plane.1],
-        );
+        let cells = plane.0 * plane.1;
+        let (Some(step_codes), Some(labels)) = (
+            step_codes.as_mut().get_mut(..cells),
+            labels.as_mut().get_mut(..cells),
+        ) else {
+            return None;
+        };
         let (pixel_row, flag_row) = (pixel_row.as_mut(), flag_row.as_mut());
         // 1. Noise and scene.
         let noise = noise_sigma(frame, win, hist, pixel_row);
@@ -272,13 +275,19 @@ impl Auto {
             win,
             plane,
         );
+        let (Some(col_sat), Some(row_sat)) = (
+            col_sat.as_mut().get_mut(region.rx0..region.rx1),
+            row_sat.as_mut().get_mut(region.ry0..region.ry1),
+        ) else {
+            return None;
+        };
         let counts = count_saturation::<C>(
             frame,
             &gate,
             &region,
             self.near_saturation(frame, noise.sigma),
-            &mut col_sat.as_mut()[region.rx0..region.rx1],
-            &mut row_sat.as_mut()[region.ry0..region.ry1],
+            col_sat,
+            row_sat,
         );
         // 6. Saturated target, then the outermost boundaries.
         let saturated = self.is_saturated(counts.sat_px, counts.near_px);

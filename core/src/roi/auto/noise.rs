@@ -74,7 +74,9 @@ fn for_each_noise_sample(
     let stride = (win.h / NOISE_ROWS).max(1);
     for y in (win.y0 + stride / 2..win.y0 + win.h).step_by(stride) {
         let row = win.row(frame, y);
-        let clamped = &mut buf[..row.len()];
+        let Some(clamped) = buf.get_mut(..row.len()) else {
+            continue;
+        };
         for (c, &v) in clamped.iter_mut().zip(row) {
             *c = v.min(max_dn);
         }

@@ -62,13 +62,16 @@ impl Gate<'_> {
     /// True when pixel `(x, y)` (frame coordinates, inside the region) is gated.
     #[inline(always)]
     pub fn contains(&self, x: usize, y: usize) -> bool {
-        self.cells[(y - self.win.y0) / BLOCK * self.pw + (x - self.win.x0) / BLOCK] != 0
+        let i = y.wrapping_sub(self.win.y0) / BLOCK * self.pw + x.wrapping_sub(self.win.x0) / BLOCK;
+        self.cells.get(i).is_some_and(|&g| g != 0)
     }
 
     /// Cells `ca..cb` of cell row `cy`.
     #[inline(always)]
     pub fn cells(&self, cy: usize, ca: usize, cb: usize) -> &[u8] {
-        &self.cells[cy * self.pw + ca..cy * self.pw + cb]
+        self.cells
+            .get(cy * self.pw + ca..cy * self.pw + cb)
+            .unwrap_or(&[])
     }
 }
 
@@ -98,30 +101,38 @@ pub(super) fn build_gate<'a>(
     let (cwa, cwb) = (ca.saturating_sub(1), (cb + 1).min(pw));
     // The winner's cells of one cell row, padded by a cell on each side:
     // `winner[cx + 1]` is cell cx.
-    let winner = &mut winner_row[..pw + 2];
+    let Some(winner) = winner_row.get_mut(..pw + 2) else {
+        return Gate {
+            cells: labels,
+            pw,
+            win,
+        };
+    };
     winner.fill(false);
     for cy in ra.saturating_sub(1)..(rb + 1).min(ph) {
-        let cells = &labels[cy * pw + cwa..cy * pw + cwb];
-        for (w, &l) in winner[cwa + 1..cwb + 1].iter_mut().zip(cells) {
+        let cells = labels.get(cy * pw + cwa..cy * pw + cwb).unwrap_or(&[]);
+        let padded = winner.get_mut(cwa + 1..cwb + 1).unwrap_or(&mut []);
+        for (w, &l) in padded.iter_mut().zip(cells) {
             *w = parent[usize::from(l)] == root;
         }
         // Along the row: out[cx] = w[cx − 1] | w[cx] | w[cx + 1].
-        let out = &mut row_dilated[cy * pw + ca..cy * pw + cb];
-        let (left, mid, right) = (&winner[ca..cb], &winner[ca + 1..], &winner[ca + 2..]);
+        let Some(out) = row_dilated.get_mut(cy * pw + ca..cy * pw + cb) else {
+            continue;
+        };
+        let at = |r: core::ops::RangeFrom<usize>| winner.get(r).unwrap_or(&[]);
+        let (left, mid, right) = (at(ca..), at(ca + 1..), at(ca + 2..));
         for (((o, &l), &m), &r) in out.iter_mut().zip(left).zip(mid).zip(right) {
             *o = u8::from(l | m | r);
         }
     }
     for cy in ra..rb {
-        let row = |gy: usize| &row_dilated[gy * pw + ca..gy * pw + cb];
+        let row = |gy: usize| row_dilated.get(gy * pw + ca..gy * pw + cb).unwrap_or(&[]);
         let up = row(cy.saturating_sub(1));
-        let down = row((cy + 1).min(ph - 1));
-        for (((g, &u), &m), &d) in labels[cy * pw + ca..cy * pw + cb]
-            .iter_mut()
-            .zip(up)
-            .zip(row(cy))
-            .zip(down)
-        {
+        let down = row((cy + 1).min(ph.saturating_sub(1)));
+        let Some(gated) = labels.get_mut(cy * pw + ca..cy * pw + cb) else {
+            continue;
+        };
+        for (((g, &u), &m), &d) in gated.iter_mut().zip(up).zip(row(cy)).zip(down) {
             *g = u | m | d;
         }
     }
@@ -175,8 +186,9 @@ pub(super) fn count_saturation<'a, C: FrameCapacity>(
     let runs = runs.as_mut();
     let (mut n_runs, mut runs_row) = (0, usize::MAX);
     for (y, rs) in (ry0..ry1).zip(row_sat.iter_mut()) {
-        let Some(row) = frame.row(y) else { continue };
-        let row = &row[rx0..rx1];
+        let Some(row) = frame.row(y).and_then(|r| r.get(rx0..rx1)) else {
+            continue;
+        };
         // Most rows of a radiometry frame hold no pixel near saturation (a max is
         // cheaper than the counts).
         if row.iter().fold(0, |m, &v| m.max(v)) < near_sat {
@@ -205,9 +217,12 @@ pub(super) fn count_saturation<'a, C: FrameCapacity>(
         }
         // (v ≥ max_dn is v saturated; near_sat ≤ max_dn: no clamp needed.)
         let (mut sat_row, mut near) = (0u16, 0u16);
-        for &(a, b) in &runs[..n_runs] {
+        for &(a, b) in runs.get(..n_runs).unwrap_or(&[]) {
             let (a, b) = (usize::from(a), usize::from(b));
-            for (&v, cs) in row[a..b].iter().zip(&mut col_sat[a..b]) {
+            let (Some(px), Some(counts)) = (row.get(a..b), col_sat.get_mut(a..b)) else {
+                continue;
+            };
+            for (&v, cs) in px.iter().zip(counts) {
                 let sat = u16::from(v >= max_dn);
                 *cs += sat;
                 sat_row += sat;
@@ -252,7 +267,7 @@ pub(super) fn outline(
     };
     let gated = |x: usize, y: usize| gate.contains(x, y);
     let clamp = |v: u16| v.min(max_dn);
-    let rows = |y: usize| frame.row(y).map(|r| &r[..fw]);
+    let rows = |y: usize| frame.row(y).and_then(|r| r.get(..fw));
     // A boundary at pixel x of row y from a horizontal step: `Some(b)` (a boundary
     // before column b) when |v(x+1) − v(x−1)| ≥ τ, no neighbouring step along the
     // row is larger, and the pixels are gated (and unsaturated, unless kept).
@@ -270,7 +285,10 @@ pub(super) fn outline(
         if x == 0 || x + 1 >= fw {
             return None;
         }
-        let (l, v, r) = (clamp(row[x - 1]), clamp(row[x]), clamp(row[x + 1]));
+        let (Some(&l), Some(&v), Some(&r)) = (row.get(x - 1), row.get(x), row.get(x + 1)) else {
+            return None;
+        };
+        let (l, v, r) = (clamp(l), clamp(v), clamp(r));
         let step = l.abs_diff(r);
         let beyond = if l == 0 {
             Some((x + 1, y))
@@ -283,7 +301,10 @@ pub(super) fn outline(
         {
             return None;
         }
-        let before = x.checked_sub(2).map_or(0, |i| clamp(row[i]).abs_diff(v));
+        let before = x
+            .checked_sub(2)
+            .and_then(|i| row.get(i))
+            .map_or(0, |&w| clamp(w).abs_diff(v));
         let after = row.get(x + 2).map_or(0, |&w| clamp(w).abs_diff(v));
         (step >= before && step >= after).then_some(if v.abs_diff(l) >= v.abs_diff(r) {
             x
@@ -297,7 +318,10 @@ pub(super) fn outline(
         else {
             return None;
         };
-        let (u, v, d) = (clamp(a[x]), clamp(v[x]), clamp(d[x]));
+        let (Some(&u), Some(&v), Some(&d)) = (a.get(x), v.get(x), d.get(x)) else {
+            return None;
+        };
+        let (u, v, d) = (clamp(u), clamp(v), clamp(d));
         let step = u.abs_diff(d);
         let beyond = if u == 0 {
             Some((x, y + 1))
@@ -377,7 +401,9 @@ pub(super) fn outline(
             return false;
         };
         // Most rows hold no candidate: one pass that vectorises says so.
-        let (a, d) = (&a[rx0..rx1], &d[rx0..rx1]);
+        let (Some(a), Some(d)) = (a.get(rx0..rx1), d.get(rx0..rx1)) else {
+            return false;
+        };
         let largest = a
             .iter()
             .zip(d)
@@ -487,10 +513,10 @@ pub(super) fn saturated_box(col_sat: &[u16], x0: usize, row_sat: &[u16], y0: usi
         let (mut a, mut b) = (first, last + 1);
         let line = usize::from(TRIM_LINE_PX);
         for _ in 0..TRIM_PASSES {
-            if b - a > line && counts[a] <= TRIM_LINE_PX {
+            if b - a > line && counts.get(a).is_some_and(|&c| c <= TRIM_LINE_PX) {
                 a += 1;
             }
-            if b - a > line && counts[b - 1] <= TRIM_LINE_PX {
+            if b - a > line && counts.get(b - 1).is_some_and(|&c| c <= TRIM_LINE_PX) {
                 b -= 1;
             }
         }

@@ -23,7 +23,9 @@ pub(super) fn step_plane(
 ) {
     let max_dn = frame.max_dn();
     let n = win.w;
-    let band = &mut band[..n];
+    let Some(band) = band.get_mut(..n) else {
+        return;
+    };
     // q = cm · 4/σ, as a 16.16 reciprocal.
     let inv = (u64::from(STEP_UNITS_PER_SIGMA) << 16) / u64::from(sigma.max(1));
     // The smallest step in DN whose σ/4 units reach `floor`: cm · inv ≥ floor · 2^16.
@@ -38,7 +40,7 @@ pub(super) fn step_plane(
     };
     let c = |v: u16| v.min(max_dn);
     let last = win.y0 + win.h - 1;
-    for (cy, plane_row) in plane.chunks_exact_mut(pw).enumerate() {
+    for (cy, plane_row) in plane.chunks_exact_mut(pw.max(1)).enumerate() {
         band.fill(0);
         let y_end = (win.y0 + (cy + 1) * BLOCK).min(win.y0 + win.h);
         for y in (win.y0 + cy * BLOCK..y_end).step_by(2) {
@@ -49,12 +51,14 @@ pub(super) fn step_plane(
                 continue;
             }
             let span = 2.min(n - 1);
-            for (((m, &v), &r), &b) in band.iter_mut().zip(row).zip(&row[span..]).zip(below) {
+            let right = row.get(span..).unwrap_or(&[]);
+            for (((m, &v), &r), &b) in band.iter_mut().zip(row).zip(right).zip(below) {
                 let (v, r, b) = (c(v), c(r), c(b));
                 *m = (*m).max(v.abs_diff(r)).max(v.abs_diff(b));
             }
-            for x in n.saturating_sub(span)..n {
-                band[x] = band[x].max(c(row[x]).abs_diff(c(below[x])));
+            let tail = n.saturating_sub(span);
+            for ((m, &v), &b) in band.iter_mut().zip(row).zip(below).skip(tail) {
+                *m = (*m).max(c(v).abs_diff(c(b)));
             }
         }
         // Most bands hold no step that may make an edge cell: one pass that

@@ -21,7 +21,8 @@ impl Auto {
             let p = p.clip(frame.width() as u16, frame.height() as u16);
             if !p.is_empty() {
                 let m = usize::from(self.margin_px)
-                    + usize::from(p.width().max(p.height())) / usize::from(self.margin_divisor);
+                    + usize::from(p.width().max(p.height()))
+                        / usize::from(self.margin_divisor.max(1));
                 let win = Window::clipped(
                     frame,
                     usize::from(p.x0).saturating_sub(m),
