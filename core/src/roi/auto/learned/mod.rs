@@ -3,7 +3,8 @@
 //! cell and its surroundings ([`features`]: level within the frame, steps, contrast
 //! against boxes of 8–64 px and their texture); the target cells are grouped into
 //! 8-connected components, the strongest (summed score) wins, and its cells gate
-//! `auto`'s full-resolution refinement (outermost boundaries, saturated targets).
+//! `auto`'s full-resolution refinement (outermost boundaries, saturated targets);
+//! a small box is then cut to its half maximum ([`half_max`]: far targets' blur).
 //! A box's confidence is a logistic model over the winner's statistics (size, fill,
 //! sides touched, mean and best cell score, components, runner-up), fitted on our
 //! renders (`confidence_weights.rs`).
@@ -17,6 +18,7 @@ mod confidence_weights;
 pub mod features;
 pub mod forest;
 mod forest_trees;
+pub mod half_max;
 
 use super::super::plane::Window;
 use super::super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
@@ -47,7 +49,7 @@ impl Default for AutoV2 {
     fn default() -> Self {
         AutoV2 {
             fine_sigma: 8,
-            cell_score: 0,
+            cell_score: -256,
             min_score_permille: 500,
         }
     }
@@ -437,6 +439,8 @@ impl AutoV2 {
                 y1: px(usize::from(w8.y_last) + 1, fh),
             })
         });
+        // Stage 6: small boxes cut to their half maximum (far targets' blur).
+        let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
         Detection {
             roi,
             threshold: tau.into(),
