@@ -64,8 +64,8 @@ def main():
         f.write(f"pub const BIAS: i32 = {bias};\n")
         f.write("/// Roots of the trees (indices into [`NODES`]).\n")
         f.write(f"pub const ROOTS: [u16; {len(roots)}] = [{', '.join(map(str, roots))}];\n")
-        f.write("/// The trees' nodes.\n")
-        f.write(f"pub const NODES: [Node; {len(nodes)}] = [\n")
+        f.write("/// The trees' nodes (a `static`: one copy in flash).\n")
+        f.write(f"pub static NODES: [Node; {len(nodes)}] = [\n")
         for (fe, th, l, r, v) in nodes:
             f.write(f"    Node {{ feature: {fe}, threshold: {th}, left: {l}, right: {r}, value: {v} }},\n")
         f.write("];\n")

@@ -12,8 +12,8 @@ pub const ROOTS: [u16; 100] = [
     2150, 2181, 2212, 2243, 2272, 2301, 2332, 2363, 2394, 2425, 2454, 2485, 2514, 2545, 2576, 2605,
     2634, 2663, 2694, 2725, 2754, 2785, 2816, 2847, 2878, 2909, 2940, 2971, 3002, 3033,
 ];
-/// The trees' nodes.
-pub const NODES: [Node; 3064] = [
+/// The trees' nodes (a `static`: one copy in flash).
+pub static NODES: [Node; 3064] = [
     Node {
         feature: 0,
         threshold: 239,
