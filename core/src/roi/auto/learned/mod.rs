@@ -505,10 +505,7 @@ impl Detector for AutoV2 {
         let roi = d.roi.unwrap_or(Roi::EMPTY);
         let mask_row = &mut work.flag_row.as_mut()[..frame.width()];
         for y in 0..frame.height() {
-            mask_row.fill(false);
-            if roi.contains(roi.x0, y as u16) {
-                mask_row[usize::from(roi.x0)..usize::from(roi.x1)].fill(true);
-            }
+            roi.fill_mask_row(y, mask_row);
             sink(y, mask_row);
         }
         d.threshold
