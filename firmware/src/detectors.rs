@@ -149,6 +149,19 @@ impl Detectors {
     }
 }
 
+impl Detectors {
+    /// Otsu's refinement passes (frame reads between its histogram and mask passes) in
+    /// the last call, when Otsu ran last (`None` otherwise): what the worst-case run
+    /// prints against the proven bound
+    /// ([`tirroi_core::roi::otsu::max_refinement_passes`]).
+    pub fn otsu_passes(&self) -> Option<u8> {
+        match &self.shared {
+            SharedScratch::Otsu(scratch) => Some(scratch.work().refinement_passes()),
+            _ => None,
+        }
+    }
+}
+
 impl Default for Detectors {
     fn default() -> Self {
         Self::new()
