@@ -1335,7 +1335,7 @@ fn two_blobs_on_a_full_frame() {
 /// lib.rs's memory table: (detector, its `SCRATCH_BYTES`, what `Method` reports, the
 /// budget, the exact bytes on x86-64). Stated numbers, not recomputed from the types.
 const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 4] = [
-    ("otsu", otsu::SCRATCH_BYTES, Method::Otsu, 16 * 1024, 15_216),
+    ("otsu", otsu::SCRATCH_BYTES, Method::Otsu, 16 * 1024, 15_224),
     (
         "adaptive",
         adaptive::SCRATCH_BYTES,

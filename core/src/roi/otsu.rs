@@ -8,17 +8,21 @@
 //! A full 2^14-bin histogram would take 64 KiB. Instead the detector histograms the
 //! frame into [`COARSE_BINS`] bins (count and sum of each), evaluates σ_B² exactly at
 //! every bin boundary, and bounds it from above inside every bin (branch and bound).
-//! Only bins whose bound reaches the best boundary value are histogrammed at full
-//! resolution in further passes, [`FINE_SLOTS`] DN at a time. All arithmetic is exact
+//! Only bins whose bound reaches the best boundary value (and that pass the
+//! nearest-mean condition below) are histogrammed at full resolution in further
+//! passes, [`FINE_SLOTS`] DN at a time. All arithmetic is exact
 //! integer arithmetic, so the result equals an exhaustive search over every threshold
-//! `0..max_dn`, ties going to the smallest threshold. Typical frames need one or two
-//! extra passes.
+//! `0..max_dn`, ties going to the smallest threshold. Typical frames need one extra
+//! pass, two-valued frames none.
 //!
 //! **Worst case.** Only bins that can hold an optimal split are refined, and an optimal
-//! split obeys the nearest-mean condition (Otsu's threshold is the optimal 1-D 2-means
-//! partition: moving the brightest background pixel `x` to the foreground cannot
-//! lower the within-class sum of squares, so `x ≤ (μ₀ + μ₁)/2`, and likewise the darkest
-//! foreground pixel `y ≥ (μ₀ + μ₁)/2`). With `μ₀ ≤ M/N ≤ μ₁` and every DN in
+//! split obeys the nearest-mean condition. Maximising σ_B² minimises the within-class
+//! sum of squares, and Otsu's split minimises it over all two-class partitions (a 1-D
+//! 2-means optimum, which always separates the classes by a threshold). Moving one
+//! background pixel `x` to the foreground changes that sum by
+//! `n₁/(n₁+1)·(x − μ₁)² − n₀/(n₀−1)·(x − μ₀)² ≥ 0`, so `|x − μ₁| ≥ |x − μ₀|`: the brightest
+//! background pixel has `x ≤ (μ₀ + μ₁)/2` (trivially when `n₀ = 1`), and likewise the
+//! darkest foreground pixel `y ≥ (μ₀ + μ₁)/2`. With `μ₀ ≤ M/N ≤ μ₁` and every DN in
 //! `v_min..=v_max`, a split strictly inside a bin `lo..=hi` needs
 //! `lo ≤ x ≤ (M/N + v_max)/2` and `hi ≥ y ≥ (v_min + M/N)/2`: the bin's start lies in an
 //! interval shorter than `(v_max − v_min)/2 + width < 65 · width`, so at most
