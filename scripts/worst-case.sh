@@ -10,7 +10,9 @@
 # bound exceeds 1.25x its largest count (too loose: lower it); and, for `auto` within a
 # work budget (a ladder of budgets on every frame and prior), when a call counts more
 # instructions than it charged or charges more than its budget. Writes the table (bound,
-# max, mean, ms at 100 MHz) to $CARGO_TARGET_DIR/worst-case/table.md.
+# max, mean, ms at 100 MHz) to $CARGO_TARGET_DIR/worst-case/table.md, and Otsu's
+# refinement passes per frame to $CARGO_TARGET_DIR/worst-case/otsu-passes.txt; fails when
+# a frame takes more passes than Otsu's proven bound (core/src/roi/otsu.rs, "Worst case").
 #
 # Usage: scripts/worst-case.sh
 # Needs: apt-get install rustc-web cargo-web rust-web-src lld qemu-system-arm
@@ -52,11 +54,12 @@ echo "worst-case: $(awk '/^worst done/ { sub("calls=", "", $3); print $3 }' "$ou
 # auto's fixed charge per call (core/src/roi/auto/budget.rs, CALL_INSTR).
 call_instr=$(sed -n 's/^pub const CALL_INSTR: u32 = \([0-9_]*\);.*/\1/p' core/src/roi/auto/budget.rs | tr -d _)
 [[ -n $call_instr ]] || die "CALL_INSTR not found in core/src/roi/auto/budget.rs"
-awk -v slack="$max_slack" -v table="$out/table.md" -v call_instr="$call_instr" '
+awk -v slack="$max_slack" -v table="$out/table.md" -v passes_file="$out/otsu-passes.txt" -v call_instr="$call_instr" '
     FNR == NR {
         if ($0 ~ /^[ \t]*(#|$)/) next
         bound[$1] = $2; order[++n] = $1; next
     }
+    $1 == "worst" && $2 ~ /^otsu-pass-bound=/ { split($2, kv, "="); pass_bound = kv[2] + 0; next }
     $1 == "worst" && /instructions=/ {
         delete v
         for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
@@ -72,6 +75,12 @@ awk -v slack="$max_slack" -v table="$out/table.md" -v call_instr="$call_instr" '
             next
         }
         calls[m]++; sum[m] += x
+        if ("passes" in v) {
+            p = v["passes"] + 0; pass_calls++
+            printf "%s passes=%d instructions=%d\n", v["case"], p, x > passes_file
+            if (pass_calls == 1 || p > max_passes) { max_passes = p; max_passes_at = v["case"] }
+            pass_hist[p]++
+        }
         if (!(m in max) || x > max[m]) { max[m] = x; at[m] = v["case"] (("prior" in v) ? " prior " v["prior"] : "") }
         if (!(m in seen)) { seen[m] = 1; extra[++k] = m }
     }
@@ -89,6 +98,14 @@ awk -v slack="$max_slack" -v table="$out/table.md" -v call_instr="$call_instr" '
             if (ratio > slack) { printf "worst-case: error: %s: bound %d is more than %.2fx the largest count %d: lower it\n", m, bound[m], slack, max[m]; bad = 1 }
         }
         for (j = 1; j <= n; j++) if (!(order[j] in seen)) printf "worst-case: note: %s has a bound but was not run\n", order[j]
+        if (pass_calls == 0 || pass_bound == 0) { print "worst-case: error: no Otsu pass counts (passes=, otsu-pass-bound=) in the run"; bad = 1 }
+        else {
+            line = ""
+            for (p = 0; p <= pass_bound + 1; p++) if (p in pass_hist) line = line " " p ":" pass_hist[p]
+            printf "worst-case: otsu refinement passes: max %d (%s), proven bound %d; frames per pass count:%s\n", max_passes, max_passes_at, pass_bound, line
+            printf "\nOtsu refinement passes: max %d (%s), proven bound %d; frames per pass count (passes:frames):%s.\n", max_passes, max_passes_at, pass_bound, line > table
+            if (max_passes > pass_bound) { printf "worst-case: error: otsu: %d refinement passes on %s exceed the proven bound %d\n", max_passes, max_passes_at, pass_bound; bad = 1 }
+        }
         if (budget_calls > 0) {
             line = ""
             for (st in stops) line = line " " st "=" stops[st]

@@ -45,7 +45,16 @@ fn check_otsu(img: &Img, what: &str) {
     let want_mask = mask_above(img, want_t);
     for rule in RULES {
         let det = Otsu { box_rule: rule };
-        let obs = observe(det, img);
+        let mut scratch = Otsu::scratch();
+        let obs = observe_in(det, img, &mut scratch);
+        // The proven worst case (otsu.rs, "Worst case") holds on every frame.
+        let passes = usize::from(scratch.work().refinement_passes());
+        assert!(
+            passes <= otsu::max_refinement_passes(img.bits),
+            "{what}: {passes} refinement passes, more than the proven {} at {} bits",
+            otsu::max_refinement_passes(img.bits),
+            img.bits
+        );
         assert_eq!(
             obs.detection.threshold,
             want_t,
@@ -99,6 +108,59 @@ fn otsu_matches_exhaustive_search_on_full_frames() {
             _ => few_levels_frame(&mut rng, W, H, bits),
         };
         check_otsu(&img, &format!("full frame {case}, {bits} bits"));
+    }
+}
+
+/// Otsu's worst case: frames whose between-class variance is flat over the whole
+/// interval where the optimal split may lie (`otsu::fill_flat_variance`) keep the
+/// branch and bound refining until the proven pass bound, within one pass (the bound
+/// allows 65 bins, these frames fill 62-64 of them), and still match the exhaustive
+/// search.
+#[test]
+fn otsu_flat_variance_frames_reach_the_proven_pass_bound() {
+    for (w, h, bits, spike_px) in [
+        (W, H, 14, 100),
+        (W, H, 14, 1000),
+        (W, H, 12, 100),
+        (W, H, 16, 100),
+        (64, 48, 14, 100),
+    ] {
+        let what = format!("flat variance {w}x{h} {bits}-bit, spikes of {spike_px} px");
+        let mut img = Img::constant(w, h, bits, 0);
+        otsu::fill_flat_variance(&mut img.px, max_dn(bits), spike_px);
+        assert!(
+            img.px.iter().all(|&v| v <= max_dn(bits)),
+            "{what}: DN within the bit depth"
+        );
+        check_otsu(&img, &what);
+        let mut scratch = Otsu::scratch();
+        Otsu::default()
+            .detect(&img.frame(), &mut scratch)
+            .expect("valid parameters");
+        let passes = usize::from(scratch.work().refinement_passes());
+        let bound = otsu::max_refinement_passes(bits);
+        assert!(
+            passes <= bound && passes + 1 >= bound,
+            "{what}: {passes} refinement passes, the proven bound is {bound}"
+        );
+    }
+    // The bound's arithmetic: ⌈65 bins / (512 DN per pass / bin width)⌉.
+    assert_eq!(otsu::MAX_REFINED_BINS, 65);
+    for (bits, per_pass) in [
+        (7u8, 0usize),
+        (8, 255),
+        (9, 128),
+        (12, 16),
+        (14, 4),
+        (16, 1),
+    ] {
+        assert_eq!(otsu::bins_per_pass(bits), per_pass, "{bits} bits");
+        let want = if per_pass == 0 {
+            0
+        } else {
+            65usize.div_ceil(per_pass)
+        };
+        assert_eq!(otsu::max_refinement_passes(bits), want, "{bits} bits");
     }
 }
 
@@ -1273,7 +1335,7 @@ fn two_blobs_on_a_full_frame() {
 /// lib.rs's memory table: (detector, its `SCRATCH_BYTES`, what `Method` reports, the
 /// budget, the exact bytes on x86-64). Stated numbers, not recomputed from the types.
 const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 4] = [
-    ("otsu", otsu::SCRATCH_BYTES, Method::Otsu, 16 * 1024, 15_216),
+    ("otsu", otsu::SCRATCH_BYTES, Method::Otsu, 16 * 1024, 15_224),
     (
         "adaptive",
         adaptive::SCRATCH_BYTES,

@@ -11,7 +11,8 @@
 //! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
 //! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
 //! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
-//! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: Otsu's score nearly flat over the bins between (least pruning) |
+//! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: a nearly flat score over the bins between, but not flat enough (Otsu refines 2 bins) |
+//! | `flat-variance-S` | 2 | Otsu's worst case (`otsu::fill_flat_variance`): S px at 0 and at saturation, the rest placed so that the between-class variance is flat over every bin where the optimal split may lie; Otsu refines 64 bins in 16 passes (proven bound 17), S = 100, 1 000 |
 //! | `saturated`, `black`, `ramp` | 3 | flat frames and a smooth ramp over the full range |
 //! | `tiled-L` | 4 | the fuzz target's frames (`fuzz/fuzz_targets/auto.rs`: a short run of random DN repeated to fill the frame), L = 3, 7, 31, 329 |
 //! | the embedded frames | 6 | the demo's rendered scenes |
@@ -56,6 +57,9 @@ pub enum Case {
     /// uniformly between them, from seed `N`: Otsu's between-class variance is nearly
     /// flat over every bin between the spikes, so its branch and bound prunes least.
     Spikes(u64),
+    /// Otsu's worst case: a histogram of flat between-class variance with spikes of
+    /// `S` px at 0 and at saturation ([`tirroi_core::roi::otsu::fill_flat_variance`]).
+    FlatVariance(usize),
     /// Every pixel saturated.
     Saturated,
     /// Every pixel 0.
@@ -78,6 +82,9 @@ const NOISE_SEEDS: [u64; 4] = [1, 2, 3, 4];
 const SALT_PEPPER_SEEDS: [u64; 2] = [1, 2];
 /// Seeds of the two-spike frames.
 const SPIKE_SEEDS: [u64; 2] = [1, 2];
+/// Spike sizes of the flat-variance frames, px (both make Otsu refine 64 bins; the
+/// larger spike moves the optimum and the pixels between).
+const FLAT_VARIANCE_SPIKES_PX: [usize; 2] = [100, 1000];
 /// Share of the pixels in each spike of [`Case::Spikes`], per mille.
 pub const SPIKE_PERMILLE: u64 = 450;
 /// Lengths of the fuzz-style tiled frames (329: one more than a row, a diagonal drift).
@@ -90,6 +97,7 @@ pub const COUNT: usize = MAX_CHECKER_PERIOD_PX
     + NOISE_SEEDS.len()
     + SALT_PEPPER_SEEDS.len()
     + SPIKE_SEEDS.len()
+    + FLAT_VARIANCE_SPIKES_PX.len()
     + 3
     + TILE_LENGTHS.len()
     + FRAMES.len();
@@ -130,6 +138,11 @@ pub fn case(index: usize) -> Option<Case> {
     }
     if let Some(k) = group(&mut i, SPIKE_SEEDS.len()) {
         return SPIKE_SEEDS.get(k).map(|&s| Case::Spikes(s));
+    }
+    if let Some(k) = group(&mut i, FLAT_VARIANCE_SPIKES_PX.len()) {
+        return FLAT_VARIANCE_SPIKES_PX
+            .get(k)
+            .map(|&s| Case::FlatVariance(s));
     }
     if let Some(k) = group(&mut i, 3) {
         return [Case::Saturated, Case::Black, Case::Ramp].get(k).copied();
@@ -207,6 +220,10 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
         }
         return;
     }
+    if let Case::FlatVariance(spike_px) = case {
+        tirroi_core::roi::otsu::fill_flat_variance(frame, MAX_DN, spike_px);
+        return;
+    }
     let mut tile = [0u16; TILE_LENGTHS[TILE_LENGTHS.len() - 1]];
     if let Case::Tiled(len) = case {
         for t in tile.iter_mut().take(len) {
@@ -232,7 +249,7 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
             Case::Black => 0,
             Case::Ramp => ((x + y) * usize::from(MAX_DN) / (FRAME_WIDTH + FRAME_HEIGHT - 2)) as u16,
             Case::Tiled(len) => tile.get(i % len.max(1)).copied().unwrap_or(0),
-            Case::Embedded(_) => 0,
+            Case::Embedded(_) | Case::FlatVariance(_) => 0,
         };
     }
 }
@@ -248,6 +265,7 @@ impl fmt::Display for Case {
             Case::Noise(n) => write!(f, "noise-{n}"),
             Case::SaltPepper(n) => write!(f, "salt-pepper-{n}"),
             Case::Spikes(n) => write!(f, "spikes-{n}"),
+            Case::FlatVariance(s) => write!(f, "flat-variance-{s}"),
             Case::Saturated => f.write_str("saturated"),
             Case::Black => f.write_str("black"),
             Case::Ramp => f.write_str("ramp"),

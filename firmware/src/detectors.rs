@@ -17,9 +17,9 @@ pub const DEMO_METHODS: &[Method] = &Method::ALL;
 /// The one scratch area of the demo: idle, or the scratch of the detector that ran
 /// last. A fresh one is [`SharedScratch::Idle`], discriminant 0 and nothing else, so a
 /// `static` of it is zero bytes in `.bss` (no initial values in flash). Switching to
-/// another detector writes that detector's fresh scratch over the area (a memset
-/// where its fresh scratch is all zeros; `auto`'s keeps a few non-zero sentinels,
-/// written from a constant in flash). Detectors keep no state between calls, so a
+/// another detector writes that detector's fresh scratch over the area (a memset:
+/// every fresh scratch is all zero bytes, `auto`'s too since session 24, so no image of
+/// one sits in flash). Detectors keep no state between calls, so a
 /// fresh scratch gives the same box as a reused one (the flight report compares every
 /// box with the host's `tirroi detect`).
 // repr(u8): an explicit tag byte, 0 for `Idle`, so the idle area is all zero bytes
@@ -145,6 +145,19 @@ impl Detectors {
         match scratch_in!(&mut self.shared, Auto) {
             Some(scratch) => params.detect_within(frame, scratch, budget),
             None => Err(NOT_SWITCHED),
+        }
+    }
+}
+
+impl Detectors {
+    /// Otsu's refinement passes (frame reads between its histogram and mask passes) in
+    /// the last call, when Otsu ran last (`None` otherwise): what the worst-case run
+    /// prints against the proven bound
+    /// ([`tirroi_core::roi::otsu::max_refinement_passes`]).
+    pub fn otsu_passes(&self) -> Option<u8> {
+        match &self.shared {
+            SharedScratch::Otsu(scratch) => Some(scratch.work().refinement_passes()),
+            _ => None,
         }
     }
 }

@@ -4,12 +4,14 @@
 //! per call over semihosting:
 //!
 //! ```text
-//! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248
+//! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248 passes=1
 //! worst case=checker-7 method=auto+prior prior=0,0,16,16 instructions=612400 box=none
 //! worst case=checker-7 method=auto-budget prior=none budget=1310720 instructions=1012440 charged=1290232 stopped=refinement box=40,8,72,40
 //! ```
 //!
-//! then `worst done calls=N` and exit 0 (1 if a detector refused its input).
+//! (`passes`: Otsu's refinement passes, against its proven bound, printed once as
+//! `worst otsu-pass-bound=17`), then `worst done calls=N` and exit 0 (1 if a detector
+//! refused its input).
 //! Instructions are counted as in `src/main.rs`: the SysTick under `qemu-system-arm
 //! -icount shift=0` (one instruction per ns, SysTick at 25 MHz: 40 instructions per
 //! tick), the cost of an empty measurement subtracted; exact to ± 40.
@@ -94,6 +96,10 @@ mod target {
 
         let overhead = (0..8).map(|_| count(0, || ()).1).min().unwrap_or(0);
         hprintln!("worst overhead={overhead} cases={}", adversarial::COUNT);
+        hprintln!(
+            "worst otsu-pass-bound={}",
+            tirroi_core::roi::otsu::max_refinement_passes(BITS)
+        );
         let mut calls = 0u32;
         let mut failed = false;
         for index in 0..adversarial::COUNT {
@@ -110,10 +116,16 @@ mod target {
                 let (result, n) = count(overhead, || DETECTORS.run(method, &frame));
                 failed |= result.is_err();
                 calls += 1;
-                hprintln!(
-                    "worst case={case} method={method} instructions={n} box={}",
-                    BoxOf(&result)
-                );
+                match DETECTORS.otsu_passes().filter(|_| method == Method::Otsu) {
+                    Some(passes) => hprintln!(
+                        "worst case={case} method={method} instructions={n} box={} passes={passes}",
+                        BoxOf(&result)
+                    ),
+                    None => hprintln!(
+                        "worst case={case} method={method} instructions={n} box={}",
+                        BoxOf(&result)
+                    ),
+                }
             }
             if DEMO_METHODS.contains(&Method::Auto) {
                 for prior in PRIORS {

@@ -8,11 +8,29 @@
 //! A full 2^14-bin histogram would take 64 KiB. Instead the detector histograms the
 //! frame into [`COARSE_BINS`] bins (count and sum of each), evaluates σ_B² exactly at
 //! every bin boundary, and bounds it from above inside every bin (branch and bound).
-//! Only bins whose bound reaches the best boundary value are histogrammed at full
-//! resolution in further passes, [`FINE_SLOTS`] DN at a time. All arithmetic is exact
+//! Only bins whose bound reaches the best boundary value (and that pass the
+//! nearest-mean condition below) are histogrammed at full resolution in further
+//! passes, [`FINE_SLOTS`] DN at a time. All arithmetic is exact
 //! integer arithmetic, so the result equals an exhaustive search over every threshold
-//! `0..max_dn`, ties going to the smallest threshold. Typical frames need one or two
-//! extra passes.
+//! `0..max_dn`, ties going to the smallest threshold. Typical frames need one extra
+//! pass, two-valued frames none.
+//!
+//! **Worst case.** Only bins that can hold an optimal split are refined, and an optimal
+//! split obeys the nearest-mean condition. Maximising σ_B² minimises the within-class
+//! sum of squares, and Otsu's split minimises it over all two-class partitions (a 1-D
+//! 2-means optimum, which always separates the classes by a threshold). Moving one
+//! background pixel `x` to the foreground changes that sum by
+//! `n₁/(n₁+1)·(x − μ₁)² − n₀/(n₀−1)·(x − μ₀)² ≥ 0`, so `|x − μ₁| ≥ |x − μ₀|`: the brightest
+//! background pixel has `x ≤ (μ₀ + μ₁)/2` (trivially when `n₀ = 1`), and likewise the
+//! darkest foreground pixel `y ≥ (μ₀ + μ₁)/2`. With `μ₀ ≤ M/N ≤ μ₁` and every DN in
+//! `v_min..=v_max`, a split strictly inside a bin `lo..=hi` needs
+//! `lo ≤ x ≤ (M/N + v_max)/2` and `hi ≥ y ≥ (v_min + M/N)/2`: the bin's start lies in an
+//! interval shorter than `(v_max − v_min)/2 + width < 65 · width`, so at most
+//! [`MAX_REFINED_BINS`] = 65 bins are ever refined, in at most
+//! [`max_refinement_passes`] frame reads (17 at 14 bits). A histogram whose
+//! between-class variance is flat over the whole allowed interval
+//! ([`fill_flat_variance`]) makes the branch and bound refine 64 of them: 16 passes at
+//! 14 bits.
 //!
 //! The reported [`Detection::threshold`](super::Detection::threshold) is that smallest
 //! maximising `t`, i.e. the brightest DN present in the background class. A frame
@@ -34,6 +52,37 @@ const LANES: usize = 4;
 pub const FINE_SLOTS: usize = 512;
 /// Marks a coarse bin that is not refined in the current pass.
 const NOT_REFINED: u8 = u8::MAX;
+/// The most coarse bins one call refines at full resolution, for any frame and bit
+/// depth: the nearest-mean condition (module documentation) leaves an interval shorter
+/// than 65 bin widths for the starts of the bins that may hold the optimal split.
+pub const MAX_REFINED_BINS: usize = COARSE_BINS / 2 + 1;
+
+/// Bins refined per frame read at bit depth `bits` (`FINE_SLOTS` / bin width; 4 at 14
+/// bits), or 0 when the coarse histogram is already at full resolution (`bits ≤ 7`).
+pub const fn bins_per_pass(bits: u8) -> usize {
+    let shift = bits.saturating_sub(COARSE_SHIFT_BITS);
+    if shift == 0 {
+        return 0;
+    }
+    let per_pass = FINE_SLOTS >> shift;
+    if per_pass == 0 {
+        1
+    } else if per_pass > NOT_REFINED as usize {
+        NOT_REFINED as usize
+    } else {
+        per_pass
+    }
+}
+
+/// The most refinement passes (frame reads after the histogram pass, before the mask
+/// pass) one call makes at bit depth `bits`, on any frame: ⌈[`MAX_REFINED_BINS`] /
+/// [`bins_per_pass`]⌉ (17 at 14 bits, 65 at 16 bits, 0 at 7 bits and below).
+pub const fn max_refinement_passes(bits: u8) -> usize {
+    match bins_per_pass(bits) {
+        0 => 0,
+        per_pass => MAX_REFINED_BINS.div_ceil(per_pass),
+    }
+}
 
 /// Parameters of the Otsu detector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -58,6 +107,17 @@ pub struct OtsuWork<C: FrameCapacity = Reference> {
     /// Position of each coarse bin in `fine` (in bins), or [`NOT_REFINED`].
     slot: [u8; COARSE_BINS],
     mask: C::Row<bool>,
+    /// Refinement passes (frame reads) of the last call.
+    passes: u8,
+}
+
+impl<C: FrameCapacity> OtsuWork<C> {
+    /// Refinement passes of the last call: frame reads between the histogram pass and
+    /// the mask pass, at most [`max_refinement_passes`] of the frame's bit depth (0
+    /// before the first call).
+    pub fn refinement_passes(&self) -> u8 {
+        self.passes
+    }
 }
 
 impl<C: FrameCapacity> ConstInit for OtsuWork<C> {
@@ -68,6 +128,7 @@ impl<C: FrameCapacity> ConstInit for OtsuWork<C> {
         // NOT_REFINED before reading it.
         slot: [0; COARSE_BINS],
         mask: ConstInit::INIT,
+        passes: 0,
     };
 }
 
@@ -173,6 +234,7 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
     // compiler, so indexing by a bin needs no bounds check.
     let bins = ((usize::from(max_dn) >> shift) + 1).min(COARSE_BINS);
     let low_mask = (bin_width - 1) as u16;
+    work.passes = 0;
 
     let lanes = &mut work.coarse;
     for lane in lanes.iter_mut() {
@@ -219,13 +281,19 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
         t: max_dn,
     };
     let (mut n0, mut m0) = (0u64, 0u64);
+    let (mut first_bin, mut last_bin) = (bins, 0);
     for b in 0..bins {
         n0 += count(b);
         m0 += sum(b);
+        if count(b) > 0 {
+            first_bin = first_bin.min(b);
+            last_bin = b;
+        }
         if let Some(s) = totals.score(n0, m0) {
             best.offer(s, n0, (((b + 1) << shift) - 1) as u16);
         }
     }
+    let nearest = NearestMean::new(&totals, first_bin << shift, ((last_bin + 1) << shift) - 1);
     if bin_width == 1 {
         // Already at full resolution (no split at all: a single DN value, all background).
         return best.t;
@@ -234,6 +302,8 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
     // Branch and bound: histogram at full resolution, a few bins per pass, the bins
     // whose bound reaches the best score so far (in order; later passes prune more).
     let bins_per_pass = (FINE_SLOTS / bin_width).clamp(1, usize::from(NOT_REFINED));
+    // Bins that can hold an optimal split (at most MAX_REFINED_BINS): a pass count of
+    // at most ⌈MAX_REFINED_BINS / bins_per_pass⌉.
     let mut next_bin = 0;
     loop {
         let slot = &mut work.slot;
@@ -245,6 +315,7 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
             if b >= next_bin
                 && usize::from(picked) < bins_per_pass
                 && count(b) > 1
+                && nearest.may_hold_split(b << shift, ((b + 1) << shift) - 1)
                 && bin_may_beat(&totals, &best, b, shift, (n_a, m_a), (n_b, m_b))
             {
                 *bin_slot = picked;
@@ -256,6 +327,7 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
         if picked == 0 {
             return best.t;
         }
+        work.passes = work.passes.saturating_add(1);
         let [even, odd] = &mut work.fine;
         // picked ≤ bins_per_pass, so `used` ≤ FINE_SLOTS (bin_width ≤ 2^9 = FINE_SLOTS
         // at 16 bits); `min` only says so.
@@ -314,6 +386,38 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
     }
 }
 
+/// The nearest-mean condition of an optimal split (module documentation), in exact
+/// integers: the brightest background DN `x` obeys `2·N·x ≤ M + N·v_max` and the darkest
+/// foreground DN `y` obeys `2·N·y ≥ M + N·v_min`.
+struct NearestMean {
+    /// `2·N`.
+    two_n: u64,
+    /// `M + N·v_min`.
+    low: u64,
+    /// `M + N·v_max`.
+    high: u64,
+}
+
+impl NearestMean {
+    /// The condition for a frame of these totals whose DN lie in `v_min..=v_max`
+    /// (bounds from the coarse histogram: the first DN of the first occupied bin, the
+    /// last of the last; any wider range is also correct, only less tight).
+    fn new(totals: &Totals, v_min: usize, v_max: usize) -> Self {
+        NearestMean {
+            two_n: 2 * totals.n,
+            low: totals.m + totals.n * v_min as u64,
+            high: totals.m + totals.n * v_max as u64,
+        }
+    }
+
+    /// False when no optimal split can lie strictly inside the DN `lo..=hi`: it would
+    /// need a background pixel `x ≥ lo` and a foreground pixel `y ≤ hi` there.
+    /// (`2·N·DN < 2^37` and `M + N·v < 2^37` for every capacity: no overflow.)
+    fn may_hold_split(&self, lo: usize, hi: usize) -> bool {
+        self.two_n * lo as u64 <= self.high && self.two_n * hi as u64 >= self.low
+    }
+}
+
 /// Upper bound of σ_B² over the thresholds strictly inside bin `b` (DN
 /// `lo..lo + width − 1`), compared with `best`: true when the bin could hold a split
 /// at least as good. `(n_a, m_a)` and `(n_b, m_b)` are the background class before
@@ -365,6 +469,55 @@ fn bin_may_beat(
         bound = smaller(bound, larger(score(cap, n_lo), score(cap, n_hi)));
     }
     bound.cmp(&best.score).is_ge()
+}
+
+/// Otsu's worst case (module documentation, "Worst case"): fills `pixels` (any frame,
+/// raster order) with DN in `0..=max_dn` whose between-class variance is as flat as
+/// integers allow over the whole interval where an optimal split may lie, so the branch
+/// and bound prunes (almost) nothing there. `spike_px` pixels (at least 1) are 0 and as
+/// many are `max_dn`; the dark half of the others is placed pixel by pixel, each at the
+/// DN that keeps the score of every split equal to the one just after the dark spike
+/// (`d(n₀)² = c·n₀·(N − n₀)`, `d` rising by `M − N·v` per pixel of DN `v`); the bright
+/// half mirrors it about `max_dn / 2` (so `M = N·max_dn/2`). Spikes of 100 or 1 000 pixels
+/// on a 328×248 14-bit frame make [`Otsu`] refine 64 bins in 16 passes
+/// ([`max_refinement_passes`]: 17). Integer arithmetic only, no panics (the firmware
+/// makes the frame on board).
+pub fn fill_flat_variance(pixels: &mut [u16], max_dn: u16, spike_px: usize) {
+    let n = pixels.len();
+    let half = n / 2;
+    let spike = spike_px.clamp(1, half.max(1));
+    let n128 = n as u128;
+    // Total sum of the mirrored histogram (rounded down for an odd N·max_dn).
+    let m = n128 * u128::from(max_dn) / 2;
+    let mut m0 = 0u128;
+    let (dark, rest) = pixels.split_at_mut(half);
+    for (i, px) in dark.iter_mut().enumerate() {
+        let v = if i < spike {
+            0
+        } else {
+            // d = M·n₀ − N·m₀ ≥ 0 in the dark half; target after this pixel:
+            // t = sqrt(c·den') with c = M²·spike/(N − spike), den' = (n₀+1)(N − n₀ − 1),
+            // computed as M·sqrt(spike·den'·2^64/(N − spike))/2^32 (< 2^97: no overflow
+            // for N < 2^20, DN < 2^16).
+            let n0 = i as u128;
+            let d = m * n0 - (n128 * m0).min(m * n0);
+            let den = (n0 + 1) * (n128 - n0 - 1);
+            let q = ((spike as u128 * den) << 64) / (n128 - spike as u128).max(1);
+            let t = (m * q.isqrt()) >> 32;
+            ((m + d).saturating_sub(t) / n128.max(1)).min(u128::from(max_dn / 2)) as u16
+        };
+        *px = v;
+        m0 += u128::from(v);
+    }
+    // The bright half mirrors the dark one (an odd N puts max_dn/2 in the middle).
+    for (px, &v) in rest.iter_mut().rev().zip(dark.iter()) {
+        *px = max_dn - v;
+    }
+    if n % 2 == 1 {
+        if let Some(middle) = rest.first_mut() {
+            *middle = max_dn / 2;
+        }
+    }
 }
 
 /// The parameters as `name=value` pairs separated by spaces (as in tuning reports

@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
-use tirroi_core::roi::auto::{AutoScratch, BudgetReport, WorkBudget};
+use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method, Roi};
 
@@ -12,14 +12,25 @@ use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method,
 /// bank (boxed: about 141 KB) and, made on the first frame that needs them, the
 /// 640×512 and 1024×768 banks; the smallest that holds a frame runs it.
 pub struct DetectorBank {
-    /// The parameters of each method, at [`Method::index`].
-    params: [Params; Method::ALL.len()],
+    /// The parameters of each method but `auto`, at [`Method::index`].
+    others: [Params; OTHERS],
+    /// `auto`'s parameters, typed: budgeted calls need an [`Auto`] (no other variant of
+    /// [`Params`] can stand in its place).
+    auto: Auto,
     scratch: Box<Detectors>,
     scratch_640x512: Option<Box<Detectors<Cap640x512>>>,
     scratch_1024x768: Option<Box<Detectors<Cap1024x768>>>,
     /// `auto`'s scratch for budgeted calls (328×248), made on the first one.
     auto_budgeted: Option<Box<AutoScratch>>,
 }
+
+/// Methods other than `auto`: the registry puts `auto` last, so they are
+/// `Method::ALL[..OTHERS]` at their own [`Method::index`].
+const OTHERS: usize = Method::ALL.len() - 1;
+const _: () = assert!(
+    Method::Auto.index() == OTHERS,
+    "auto is the registry's last method"
+);
 
 /// True when `frame` fits capacity `C`.
 fn fits<C: FrameCapacity>(frame: &Frame<'_>) -> bool {
@@ -30,7 +41,8 @@ impl Default for DetectorBank {
     /// Every detector with its default parameters.
     fn default() -> Self {
         DetectorBank {
-            params: Method::ALL.map(Method::default_params),
+            others: core::array::from_fn(|i| Method::ALL[i].default_params()),
+            auto: Auto::default(),
             scratch: Box::new(Detectors::new()),
             scratch_640x512: None,
             scratch_1024x768: None,
@@ -42,25 +54,34 @@ impl Default for DetectorBank {
 impl DetectorBank {
     /// The parameters `method` runs with.
     pub fn params(&self, method: Method) -> Params {
-        self.params[method.index()]
+        // Only `auto`'s index (OTHERS) is past the end of `others`.
+        self.others
+            .get(method.index())
+            .copied()
+            .unwrap_or(Params::Auto(self.auto))
     }
 
     /// Sets the parameters of their method (the other methods keep theirs).
     pub fn set_params(&mut self, params: Params) {
-        self.params[params.method().index()] = params;
+        match params {
+            Params::Auto(auto) => self.auto = auto,
+            other => {
+                if let Some(slot) = self.others.get_mut(other.method().index()) {
+                    *slot = other;
+                }
+            }
+        }
     }
 
     /// Sets `auto`'s tracking prior (the last frame's box; `None`: search the whole
     /// frame).
     pub fn set_prior(&mut self, prior: Option<Roi>) {
-        if let Params::Auto(auto) = &mut self.params[Method::Auto.index()] {
-            auto.prior = prior;
-        }
+        self.auto.prior = prior;
     }
 
     /// Sets the mask-to-box rule of every detector (`auto` has none).
     pub fn set_box_rule(&mut self, rule: BoxRule) {
-        for p in &mut self.params {
+        for p in &mut self.others {
             p.set_box_rule(rule);
         }
     }
@@ -71,7 +92,7 @@ impl DetectorBank {
     /// The core's [`DetectError`] for parameters out of bounds or a frame above the
     /// largest capacity (1024×768).
     pub fn detect(&mut self, method: Method, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        let params = &self.params[method.index()];
+        let params = &self.params(method);
         if fits::<tirroi_core::Reference>(frame) {
             self.scratch.detect(params, frame)
         } else if fits::<Cap640x512>(frame) {
@@ -141,10 +162,7 @@ impl DetectorBank {
         budget: WorkBudget,
         repeat: usize,
     ) -> Result<(Detection, BudgetReport, f64), DetectError> {
-        let auto = match self.params[Method::Auto.index()] {
-            Params::Auto(auto) => auto,
-            _ => Default::default(),
-        };
+        let auto = self.auto;
         let scratch = self.auto_budgeted.get_or_insert_with(Box::default);
         let mut times = Vec::with_capacity(repeat.max(1));
         let mut timed = || -> Result<(Detection, BudgetReport), DetectError> {
@@ -172,5 +190,49 @@ pub fn median(values: &mut [f64]) -> f64 {
         values[n / 2]
     } else {
         0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn params_round_trip_for_every_method_and_budgeted_auto_uses_the_prior() {
+        let mut bank = DetectorBank::default();
+        for method in Method::ALL {
+            assert_eq!(bank.params(method), method.default_params(), "{method}");
+            assert_eq!(bank.params(method).method(), method);
+        }
+        let prior = Roi::new(100, 80, 140, 120);
+        bank.set_prior(Some(prior));
+        let want = Auto::default().with_prior(Some(prior));
+        assert_eq!(bank.params(Method::Auto), Params::Auto(want));
+        // The other methods keep their defaults.
+        for method in &Method::ALL[..OTHERS] {
+            assert_eq!(bank.params(*method), method.default_params(), "{method}");
+        }
+        // A budgeted call runs the bank's `auto` (prior included): same answer as the
+        // core called directly with those parameters.
+        let px: Vec<u16> = (0..328 * 248)
+            .map(|i| {
+                if (i % 328) / 40 == 3 && (i / 328) / 40 == 2 {
+                    9000
+                } else {
+                    3000
+                }
+            })
+            .collect();
+        let frame = Frame::new(&px, 328, 248, 14).expect("valid frame");
+        let (got, report, _) = bank
+            .auto_within_timed(&frame, WorkBudget::UNLIMITED, 1)
+            .expect("default parameters");
+        let (want_d, want_report) = want
+            .detect_within(&frame, &mut AutoScratch::new(), WorkBudget::UNLIMITED)
+            .expect("default parameters");
+        assert_eq!(got, want_d);
+        assert_eq!(report, want_report);
+        bank.set_params(Params::Auto(Auto::default()));
+        assert_eq!(bank.params(Method::Auto), Method::Auto.default_params());
     }
 }

@@ -33,7 +33,19 @@ pub(super) struct CellStats {
 }
 
 impl crate::capacity::ConstInit for CellStats {
-    const INIT: Self = NO_CELLS;
+    /// All zero bytes, so a fresh `auto` scratch is all zeros (a `static` of it lands in
+    /// `.bss`, and switching a shared scratch area to `auto` is a memset, with no image of
+    /// it in flash). Never read as statistics: a label's entry is only read after
+    /// `make_set(l, NO_CELLS)` handed it out in the current labelling.
+    const INIT: Self = CellStats {
+        x0: 0,
+        y0: 0,
+        x_last: 0,
+        y_last: 0,
+        area: 0,
+        energy: 0,
+        gmax: 0,
+    };
 }
 
 impl CellStats {
