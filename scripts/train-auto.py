@@ -5,9 +5,10 @@ Input: cell CSVs written by
   cargo run --release -p tirroi-host --example auto_v2_cells -- features DIR OUT.csv
 for datasets rendered with --masks (the development family: seed 7001). A cell is a
 target cell when at least 6 of its 64 pixels' worth are covered (coverage >= 24 of
-255), background when nothing of it is; cells touched less are left out.
+255), or when it is its frame's most covered cell (a 3-12 px far target may cover
+6 px of no cell); background when nothing of it is; cells touched less are left out.
 
-Model: scikit-learn HistGradientBoostingClassifier (depth 3, 60 trees, fixed
+Model: scikit-learn HistGradientBoostingClassifier (DEPTH, TREES below, fixed
 random_state), leaf values and the bias scaled by 256 (SCORE_ONE) and rounded,
 thresholds floored (the features are integers, so `x <= t` is `x <= floor(t)`).
 
@@ -33,9 +34,15 @@ def load(paths):
     for p in paths:
         a = np.loadtxt(p, delimiter=",", skiprows=1, dtype=np.int64)
         cov = a[:, 3]
-        keep = (cov >= POSITIVE_COVERAGE) | (cov == 0)
+        pos = cov >= POSITIVE_COVERAGE
+        # Each frame's most covered cell (first in scan order on ties), when covered.
+        frame = a[:, 0]
+        order = np.lexsort((-cov, frame))
+        first = order[np.r_[True, frame[order][1:] != frame[order][:-1]]]
+        pos[first[cov[first] > 0]] = True
+        keep = pos | (cov == 0)
         xs.append(a[keep, 4:])
-        ys.append(cov[keep] >= POSITIVE_COVERAGE)
+        ys.append(pos[keep])
     return np.concatenate(xs), np.concatenate(ys)
 
 
