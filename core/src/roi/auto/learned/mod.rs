@@ -1,13 +1,15 @@
 //! `auto-v2`: `auto` with a learned region stage. Each 8×8-pixel cell is classified
 //! target or background by a forest of boosted trees over scale-free features of the
-//! cell and its surroundings ([`features`]: level within the frame, steps, contrast
-//! against boxes of 8–64 px and their texture); the target cells are grouped into
-//! 8-connected components, the strongest (summed score) wins, and its cells gate
-//! `auto`'s full-resolution refinement (outermost boundaries, saturated targets);
-//! a small box is then cut to its half maximum ([`half_max`]: far targets' blur).
-//! A box's confidence is a logistic model over the winner's statistics (size, fill,
-//! sides touched, mean and best cell score, components, runner-up), fitted on our
-//! renders (`confidence_weights.rs`).
+//! cell, of its 4×4-pixel windows (a second look at 4-px resolution: a 3–12 px far
+//! target keeps its contrast there) and of its surroundings ([`features`]: level
+//! within the frame, steps, contrast against boxes of 8–64 px and their texture); the
+//! target cells are grouped into 8-connected components, the strongest (summed score)
+//! wins, and its cells gate `auto`'s full-resolution refinement (outermost boundaries,
+//! saturated targets); a small box is then cut to its half maximum ([`half_max`]: far
+//! targets' blur) and a saturated blob by the optics' reach ([`saturated`]).
+//! A box's confidence is a logistic model over the winner's statistics (box size,
+//! fill, sides touched, best cell score, components), fitted on our renders
+//! (`confidence_weights.rs`).
 //!
 //! Unlike `auto`'s "the outline is a step" rule, the region stage learns what the
 //! background looks like (cloud texture, the limb, a real camera's shading and hot
