@@ -767,6 +767,11 @@ mod tests {
             ..det
         };
         assert!(bad.detect(&frame, &mut scratch).is_err());
+        let bad = AutoV2 {
+            saturated_erode_px: 9,
+            ..det
+        };
+        assert!(bad.detect(&frame, &mut scratch).is_err());
     }
 
     #[test]
