@@ -3,15 +3,16 @@
 //!
 //! `cargo run --release -p tirroi-host --example auto_v2_cells -- features DIR OUT.csv`
 //! writes, for every frame of a dataset rendered with `--masks`, one line per 8×8 cell:
-//! `frame,cx,cy,coverage,f0..f20` (coverage: the mean of the cell's mask values,
+//! `frame,cx,cy,coverage,f0..f26` (coverage: the mean of the cell's mask values,
 //! 0–255, i.e. the share of the cell covered by the target × 255; for a dataset without
 //! `masks/`, e.g. `tirroi fixtures --count N --seed S`, the truth box stands for the mask).
 //!
 //! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
 //! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
-//! boxed: the confidence model's training data). An optional last argument sets
-//! the cell threshold (`AutoV2::cell_score`, score units).
+//! boxed: the confidence model's training data). Optional further arguments set
+//! the cell threshold (`AutoV2::cell_score`, score units) and the saturated blob's
+//! cut (`AutoV2::saturated_erode_px`, px per side).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -59,6 +60,11 @@ fn main() {
                 .expect("cell_score: an integer, score units")
         })
         .unwrap_or(AutoV2::default().cell_score);
+    // Optional: the saturated blob's cut per side, px (default: `AutoV2::default()`'s).
+    let erode = args
+        .get(5)
+        .map(|v| v.parse::<u8>().expect("saturated_erode_px: 0..=8"))
+        .unwrap_or(AutoV2::default().saturated_erode_px);
     let list = frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -109,6 +115,7 @@ fn main() {
                         AutoV2::default().min_score_permille
                     },
                     cell_score,
+                    saturated_erode_px: erode,
                     ..AutoV2::default()
                 };
                 let d = gate_off.detect(&frame, &mut scratch).expect("detect");

@@ -1,5 +1,7 @@
 //! The plane of 8×8-pixel cells the classifier works on: per cell the mean DN, the
-//! largest step over two pixels (as a log code of σ units), in one pass over the frame.
+//! largest step over two pixels (as a log code of σ units), in one pass over the frame;
+//! and, per cell on demand, the hottest and coldest 4×4-pixel window inside it
+//! ([`sub_window_extremes`]: the finer look that keeps a 3–12 px target's contrast).
 
 use super::super::super::plane::Window;
 use crate::frame::Frame;
@@ -89,4 +91,82 @@ pub fn fill_cells(
             *m = (s / (rows * cols).max(1)) as u16;
         }
     }
+}
+
+/// Side of the finer windows the classifier also looks through, pixels: a 3–12 px far
+/// target covers at most a quarter to a half of an 8×8 cell, so its cell mean keeps a
+/// quarter of its contrast or less; a 4×4 window it fills keeps all of it.
+pub const SUB_PX: usize = 4;
+
+/// Stride of the finer windows inside a cell, pixels: half a window, so a target of
+/// 4 px or more (truth side) fills at least a 2×2-pixel quarter of some window
+/// wherever it falls inside the cell (3×3 windows per full 8×8 cell).
+pub const SUB_STRIDE_PX: usize = 2;
+
+/// Blocks of `SUB_STRIDE_PX` pixels per cell side.
+const BLOCKS: usize = CELL_PX / SUB_STRIDE_PX;
+
+/// Windows per cell side.
+const SUB_WINDOWS: usize = (CELL_PX - SUB_PX) / SUB_STRIDE_PX + 1;
+
+/// The hottest and the coldest mean DN over the 4×4-pixel windows at a 2-px stride
+/// inside cell `(cx, cy)` of `win` (3×3 windows for a full 8×8 cell; pixels clamped
+/// to the frame's top DN), read from the frame: 64 pixel reads per cell. A cell cut by
+/// the window's edge uses only the windows wholly inside it; without one (a cell less
+/// than 4 px on a side), both are its mean. `(0, 0)` for a cell outside the window.
+pub fn sub_window_extremes(frame: &Frame<'_>, win: Window, (cx, cy): (usize, usize)) -> (u16, u16) {
+    let max_dn = frame.max_dn();
+    let (xa, ya) = (win.x0 + cx * CELL_PX, win.y0 + cy * CELL_PX);
+    let xb = (xa + CELL_PX).min(win.x0 + win.w);
+    let yb = (ya + CELL_PX).min(win.y0 + win.h);
+    if xa >= xb || ya >= yb {
+        return (0, 0);
+    }
+    // Sums and pixel counts of the 2×2-pixel blocks of the cell.
+    let mut sums = [[0u32; BLOCKS]; BLOCKS];
+    let mut counts = [[0u32; BLOCKS]; BLOCKS];
+    let (mut all, mut n_all) = (0u32, 0u32);
+    for y in ya..yb {
+        let Some(row) = frame.row(y).and_then(|r| r.get(xa..xb)) else {
+            continue;
+        };
+        let by = (y - ya) / SUB_STRIDE_PX;
+        let (Some(srow), Some(crow)) = (sums.get_mut(by), counts.get_mut(by)) else {
+            continue;
+        };
+        for (i, &v) in row.iter().enumerate() {
+            let bx = i / SUB_STRIDE_PX;
+            let v = u32::from(v.min(max_dn));
+            if let (Some(s), Some(c)) = (srow.get_mut(bx), crow.get_mut(bx)) {
+                *s += v;
+                *c += 1;
+            }
+            all += v;
+            n_all += 1;
+        }
+    }
+    let per = SUB_PX / SUB_STRIDE_PX;
+    let full = (SUB_PX * SUB_PX) as u32;
+    let (mut hot, mut cold) = (None::<u32>, None::<u32>);
+    for wy in 0..SUB_WINDOWS {
+        for wx in 0..SUB_WINDOWS {
+            let (mut s, mut c) = (0u32, 0u32);
+            for (srow, crow) in sums.iter().zip(&counts).skip(wy).take(per) {
+                for (&bs, &bc) in srow.iter().zip(crow).skip(wx).take(per) {
+                    s += bs;
+                    c += bc;
+                }
+            }
+            if c == full {
+                let m = s / full;
+                hot = Some(hot.map_or(m, |h| h.max(m)));
+                cold = Some(cold.map_or(m, |h| h.min(m)));
+            }
+        }
+    }
+    let mean = all / n_all.max(1);
+    (
+        hot.unwrap_or(mean).min(u32::from(max_dn)) as u16,
+        cold.unwrap_or(mean).min(u32::from(max_dn)) as u16,
+    )
 }

@@ -11,14 +11,20 @@
 //! | 3 | `log(step / σ)`: the cell's largest step over two pixels |
 //! | 4 | `slog((top − m) / σ)`: below the frame's top DN (saturation) |
 //! | 5 + 4k … 8 + 4k | for the boxes of radius `RADII_CELLS[k]` around the cell: `slog((m − mean)/σ)`, `(m − mean) · 16 / max(sd, σ)`, the share of edge cells × 256, `log(sd / σ)` |
+//! | 21, 22 | `slog((hot − ref)/σ)`, `slog((cold − ref)/σ)`: the hottest and coldest 4×4-pixel window of the cell ([`super::cells::sub_window_extremes`]) against `ref`, the mean of the 8 neighbouring cells |
+//! | 23, 24 | `(hot − ref) · 16 / max(sd₂, σ)`, `(cold − ref) · 16 / max(sd₂, σ)`: the same in the 16-px box's own σ (clutter) |
+//! | 25, 26 | `slog((hot − m)/σ)`, `slog((cold − m)/σ)`: a small target inside the cell against the cell's own mean |
 //!
 //! `m`: the cell's mean DN; `p2`, `p50`, `p98`: percentiles of the frame's cell
 //! means; `log(x)` = [`log_code`] of `4x` (16 codes per octave of quarter-σ units),
 //! `slog` its signed form; a box is cut to the plane (its mean and standard deviation
 //! `sd` over the cells inside).
 
-/// Features per cell.
-pub const FEATURES: usize = 5 + 4 * RADII_CELLS.len();
+/// Features per cell: 5 of the cell, 4 per context box, 6 of its 4×4-pixel windows.
+pub const FEATURES: usize = 5 + 4 * RADII_CELLS.len() + SUB_FEATURES;
+
+/// Features of the finer 4×4-pixel windows (indices 21–26).
+pub const SUB_FEATURES: usize = 6;
 
 /// Radii of the context boxes, cells (8, 16, 32, 64 px): from a far target's
 /// surroundings to a close target's whole extent.
@@ -185,7 +191,9 @@ pub fn levels(mean_dn: &[u16], sigma: u32, max_dn: u16) -> FrameLevels {
     }
 }
 
-/// The features of cell `(cx, cy)` into `out`.
+/// The features of cell `(cx, cy)` into `out`; `(hot, cold)`: the cell's hottest and
+/// coldest 4×4-pixel window means, DN ([`super::cells::sub_window_extremes`]).
+#[allow(clippy::too_many_arguments)]
 pub fn cell_features(
     mean_dn: &[u16],
     step_code: &[u8],
@@ -193,6 +201,7 @@ pub fn cell_features(
     (pw, ph): (usize, usize),
     lv: FrameLevels,
     (cx, cy): (usize, usize),
+    (hot, cold): (u16, u16),
     out: &mut [i32; FEATURES],
 ) {
     let i = cy * pw + cx;
@@ -204,6 +213,8 @@ pub fn cell_features(
     out[2] = slog(i64::from(lv.p98) - m, s);
     out[3] = i32::from(step_code[i]);
     out[4] = slog(i64::from(lv.max_dn) - m, s);
+    // The 8 neighbours' mean (radius-1 box without the cell) and the 16-px box's σ.
+    let (mut reference, mut sd2) = (m, i64::from(s));
     for (k, &r) in RADII_CELLS.iter().enumerate() {
         let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
         let (x1, y1) = ((cx + r).min(pw - 1), (cy + r).min(ph - 1));
@@ -213,6 +224,12 @@ pub fn cell_features(
         // Variance of q in 1/n² units: (n Σq² − (Σq)²) / n².
         let var_n2 = (n * sum_sq).saturating_sub(sum_q * sum_q);
         let sd = ((var_n2.isqrt() / n) << lv.sd_shift) as i64;
+        if k == 0 && n > 1 {
+            reference = (sum.saturating_sub(m as u64) / (n - 1)) as i64;
+        }
+        if k == 1 {
+            sd2 = sd.max(i64::from(s));
+        }
         let d = m - mean;
         let o = 5 + 4 * k;
         out[o] = slog(d, s);
@@ -222,4 +239,14 @@ pub fn cell_features(
         out[o + 2] = (u64::from(edges) * 256 / n) as i32;
         out[o + 3] = log_code((sd as u64 * 4 / u64::from(s)).min(u64::from(u32::MAX)) as u32);
     }
+    let (hot, cold) = (i64::from(hot), i64::from(cold));
+    let o = 5 + 4 * RADII_CELLS.len();
+    let clutter =
+        |d: i64| (d * 16 / sd2).clamp(-i64::from(CONTRAST_CLAMP), i64::from(CONTRAST_CLAMP)) as i32;
+    out[o] = slog(hot - reference, s);
+    out[o + 1] = slog(cold - reference, s);
+    out[o + 2] = clutter(hot - reference);
+    out[o + 3] = clutter(cold - reference);
+    out[o + 4] = slog(hot - m, s);
+    out[o + 5] = slog(cold - m, s);
 }
