@@ -694,7 +694,9 @@ impl CloudField {
     /// renderer then only reads. The values are those a lazy build gives (each is a
     /// function of the cell alone), so the result does not depend on the thread count.
     /// Costs about 28 s of CPU for the 64 800 cells in a release build (~0.43 ms per
-    /// cell: two threshold solves on 16 × 16 points and 33 × 33 tile nodes), and holds
+    /// cell: two threshold solves on 16 × 16 points and 33 × 33 tile nodes; measured
+    /// before session 23's Gauss-exact, border-aware scale s, which adds two passes of
+    /// 96 × 96 interpolant points per cell), and holds
     /// about 165 MB ([`CloudField::memory_bytes`]: 2.2 kB of tile and 0.3 kB of coarse
     /// noise per cell).
     pub fn fill(&self) {
