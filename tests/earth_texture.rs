@@ -134,9 +134,11 @@ fn stats_tool_reproduces_the_real_image_readme() {
 /// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K, over 8 patches
 /// (2 days × 4 places, 256 × 256 px), ranges unchanged: 2-px step p99 in 9–17 K for
 /// every patch; share of steps > 10 K in 0.8–3.5 % for the median and at least 7 of 8
-/// patches (measured 2.1–3.6 %: one convective patch at 3.63 %); spectral slope
-/// (8–200 km) in −2.5…−3.3 for the median and at least 3 of 8 patches (measured: mild
-/// patches −2.25…−2.53, deep-convective −3.31…−3.49).
+/// patches; spectral slope (8–200 km) in −2.5…−3.3 for the median and at least 7 of 8
+/// patches (session 23, with the deep-convective regime and its cloud-top texture:
+/// p99 10–14.5 K, share 0.77–3.24 %, slope −2.44…−3.15; the two misses are mild
+/// patches at the ranges' edges: share 0.77 % at (20°, 202°) and slope −2.44 at
+/// (45°, 330°) on day 0).
 #[test]
 fn texture_statistics_within_the_acceptance_ranges() {
     let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
@@ -181,7 +183,7 @@ fn texture_statistics_within_the_acceptance_ranges() {
     eprintln!("median slope {k:.2}, {slopes_in} of 8 patches in range");
     assert!((-3.3..=-2.5).contains(&k), "median slope {k}");
     assert!(
-        slopes_in >= 3,
+        slopes_in >= 7,
         "{slopes_in} patches with the slope in range"
     );
 }
