@@ -125,7 +125,7 @@ timeout 900 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -monit
     -icount shift=0,align=off,sleep=off -kernel "$dtcm_elf" >"$out/dtcm.log" || rc=$?
 [[ $rc -eq 0 ]] && grep -q '^done' "$out/dtcm.log" \
     || die "the DTCM build failed on QEMU (exit $rc, see $out/dtcm.log)"
-strip_counts() { grep -E '^(detect|sensor)' "$1" | sed -E 's/ (insns|stack|[a-z]+_insns|[a-z]+_stack)=[^ ]*//g'; }
+strip_counts() { grep -E '^(detect|sensor)' "$1" | sed -E 's/ (insns|stack|[a-z_]+_insns|[a-z_]+_stack)=[^ ]*//g'; }
 diff <(strip_counts "$out/${targets[0]}.log") <(strip_counts "$out/dtcm.log") >/dev/null \
     || die "the DTCM build's boxes or sensor checksum differ from the ${targets[0]} build's"
 dtcm_statics=$(awk '$1 == ".data" || $1 == ".bss" || $1 == ".uninit" { s += $2 } END { print s + 0 }' "$out/dtcm.size")

@@ -18,7 +18,11 @@ import numpy as np
 from sklearn.ensemble import HistGradientBoostingClassifier
 
 SCORE_ONE = 256
-DEPTH, TREES = 3, 60
+# Depth 4, 100 trees (with the fixtures family in the training set): on family B (seed
+# 9001) the cell AUC rises 0.925 → 0.942 over depth 3 / 60 trees without it, and the
+# test fixtures' (seed 16) false cells at even odds fall 12 % → 0.5 %; 400 node visits
+# per 8×8 cell (≈ 6 per pixel).
+DEPTH, TREES = 4, 100
 # A cell is a target cell from 24/255 of it covered (6 of its 64 pixels): a far
 # target of 3-12 px never fills half a cell, and must still be learned.
 POSITIVE_COVERAGE = 24
@@ -61,8 +65,8 @@ def main():
         f.write(f"pub const BIAS: i32 = {bias};\n")
         f.write("/// Roots of the trees (indices into [`NODES`]).\n")
         f.write(f"pub const ROOTS: [u16; {len(roots)}] = [{', '.join(map(str, roots))}];\n")
-        f.write("/// The trees' nodes.\n")
-        f.write(f"pub const NODES: [Node; {len(nodes)}] = [\n")
+        f.write("/// The trees' nodes (a `static`: one copy in flash).\n")
+        f.write(f"pub static NODES: [Node; {len(nodes)}] = [\n")
         for (fe, th, l, r, v) in nodes:
             f.write(f"    Node {{ feature: {fe}, threshold: {th}, left: {l}, right: {r}, value: {v} }},\n")
         f.write("];\n")

@@ -7,7 +7,9 @@
 # `auto` with each border prior, and compares the counts with firmware/worst-case-bounds.txt.
 #
 # Fails when a count exceeds its method's bound, when a method has no bound, or when a
-# bound exceeds 1.25x its largest count (too loose: lower it). Writes the table (bound,
+# bound exceeds 1.25x its largest count (too loose: lower it); and, for `auto` within a
+# work budget (a ladder of budgets on every frame and prior), when a call counts more
+# instructions than it charged or charges more than its budget. Writes the table (bound,
 # max, mean, ms at 100 MHz) to $CARGO_TARGET_DIR/worst-case/table.md.
 #
 # Usage: scripts/worst-case.sh
@@ -47,7 +49,10 @@ timeout 1800 qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -moni
 grep -q '^worst done' "$out/run.log" || die "the worst-case run did not finish: see $out/run.log"
 echo "worst-case: $(awk '/^worst done/ { sub("calls=", "", $3); print $3 }' "$out/run.log") calls on QEMU in $((SECONDS - run_start)) s"
 
-awk -v slack="$max_slack" -v table="$out/table.md" '
+# auto's fixed charge per call (core/src/roi/auto/budget.rs, CALL_INSTR).
+call_instr=$(sed -n 's/^pub const CALL_INSTR: u32 = \([0-9_]*\);.*/\1/p' core/src/roi/auto/budget.rs | tr -d _)
+[[ -n $call_instr ]] || die "CALL_INSTR not found in core/src/roi/auto/budget.rs"
+awk -v slack="$max_slack" -v table="$out/table.md" -v call_instr="$call_instr" '
     FNR == NR {
         if ($0 ~ /^[ \t]*(#|$)/) next
         bound[$1] = $2; order[++n] = $1; next
@@ -56,6 +61,16 @@ awk -v slack="$max_slack" -v table="$out/table.md" '
         delete v
         for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
         m = v["method"]; x = v["instructions"] + 0
+        if (m == "auto-budget") {
+            # A budgeted call: counted <= charged (+ the counter'"'"'s 40-instruction
+            # resolution) and charged <= max(budget, the call'"'"'s fixed cost).
+            c = v["charged"] + 0; b = v["budget"] + 0
+            budget_calls++; stops[v["stopped"]]++
+            if (x > c + 40) { printf "worst-case: error: auto-budget on %s prior %s: %d instructions > %d charged (budget %d)\n", v["case"], v["prior"], x, c, b; budget_bad = 1 }
+            if (c > b && c > call_instr) { printf "worst-case: error: auto-budget on %s prior %s: charged %d > budget %d\n", v["case"], v["prior"], c, b; budget_bad = 1 }
+            if (c > 0 && x / c > worst_share) { worst_share = x / c; worst_at = v["case"] " prior " v["prior"] " budget " b }
+            next
+        }
         calls[m]++; sum[m] += x
         if (!(m in max) || x > max[m]) { max[m] = x; at[m] = v["case"] (("prior" in v) ? " prior " v["prior"] : "") }
         if (!(m in seen)) { seen[m] = 1; extra[++k] = m }
@@ -74,6 +89,12 @@ awk -v slack="$max_slack" -v table="$out/table.md" '
             if (ratio > slack) { printf "worst-case: error: %s: bound %d is more than %.2fx the largest count %d: lower it\n", m, bound[m], slack, max[m]; bad = 1 }
         }
         for (j = 1; j <= n; j++) if (!(order[j] in seen)) printf "worst-case: note: %s has a bound but was not run\n", order[j]
-        exit bad
+        if (budget_calls > 0) {
+            line = ""
+            for (st in stops) line = line " " st "=" stops[st]
+            printf "worst-case: auto-budget: %d budgeted calls, counted <= charged on all: %s; largest counted/charged %.3f (%s); stops:%s\n", budget_calls, budget_bad ? "NO" : "yes", worst_share, worst_at, line
+            printf "\n`auto` within a work budget: %d calls (every adversarial frame, no prior and each prior, budgets of 0/8..7/8 of the full charge and unlimited): instructions counted <= charged on all: %s; largest counted / charged %.3f (%s).\n", budget_calls, budget_bad ? "NO" : "yes", worst_share, worst_at > table
+        } else { print "worst-case: error: no auto-budget lines in the run"; bad = 1 }
+        exit bad || budget_bad
     }' "$bounds" "$out/run.log" || die "a worst-case bound failed (table: $out/table.md)"
 echo "worst-case: all counts within their bounds ($((SECONDS - start)) s)"

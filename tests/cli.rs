@@ -311,3 +311,44 @@ fn memory_lists_every_detectors_scratch_bytes() {
         assert!(text.contains(&row), "missing {row:?} in:\n{text}");
     }
 }
+
+#[test]
+fn detect_budget_stops_auto_and_says_where() {
+    use tirroi::core::roi::auto::{CALL_INSTR, largest_charge};
+    let dir = fixtures();
+    let file = dir.path().join("earth.png");
+    let file_arg = file.to_str().unwrap();
+    let json_of = |budget: u32, method: &str| -> Value {
+        let b = budget.to_string();
+        let out = run(&[
+            "detect", "--method", method, "--budget", &b, "--json", file_arg,
+        ]);
+        assert!(out.status.success(), "{}", stderr_text(&out));
+        serde_json::from_str(&stdout_lines(&out)[0]).expect("one JSON line")
+    };
+    // Nothing fits: the call's fixed cost only, no box, stopped before the noise stage.
+    let v = json_of(100, "auto");
+    assert_eq!(v["bbox"], Value::Null);
+    assert_eq!(v["budget"]["instructions"], 100);
+    assert_eq!(v["budget"]["charged"], CALL_INSTR);
+    assert_eq!(v["budget"]["stopped"], "noise");
+    // The largest charge of the frame size: the library's box, not stopped.
+    let most = largest_charge(328, 248, false);
+    let v = json_of(most, "auto");
+    let want = library_detection(Method::Auto, &file)
+        .roi
+        .map(|r| r.to_array());
+    let got: Option<[u16; 4]> = serde_json::from_value(v["bbox"].clone()).unwrap();
+    assert_eq!(got, want);
+    assert_eq!(v["budget"]["stopped"], Value::Null);
+    let charged = v["budget"]["charged"].as_u64().unwrap();
+    assert!(charged > u64::from(CALL_INSTR) && charged <= u64::from(most));
+    // Other methods run as without a budget, and say nothing of it.
+    let v = json_of(100, "otsu");
+    assert!(v.get("budget").is_none(), "{v}");
+    let want = library_detection(Method::Otsu, &file)
+        .roi
+        .map(|r| r.to_array());
+    let got: Option<[u16; 4]> = serde_json::from_value(v["bbox"].clone()).unwrap();
+    assert_eq!(got, want);
+}

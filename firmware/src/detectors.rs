@@ -4,7 +4,7 @@
 //! five (141 KB, the core's registry bank [`tirroi_core::roi::Detectors`]).
 
 use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
-use tirroi_core::roi::auto::{Auto, AutoScratch};
+use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
 use tirroi_core::roi::wge::{Wge, WgeScratch};
@@ -42,21 +42,33 @@ pub enum SharedScratch {
     Auto(AutoScratch),
 }
 
-/// Runs detector `$params` in the `$Variant` of a [`SharedScratch`], switching the area
-/// over to it first when another detector used it last.
-macro_rules! run_in {
-    ($shared:expr, $Variant:ident, $params:expr, $frame:expr) => {{
+/// The `$Variant` scratch of a [`SharedScratch`] (`Some`), switching the area over to it
+/// first when another detector used it last.
+macro_rules! scratch_in {
+    ($shared:expr, $Variant:ident) => {{
         let shared: &mut SharedScratch = $shared;
         if !matches!(shared, SharedScratch::$Variant(_)) {
             *shared = SharedScratch::$Variant(Scratch::new());
         }
         match shared {
-            SharedScratch::$Variant(scratch) => Detector::detect(&$params, $frame, scratch),
-            // Just switched over above.
-            _ => Err(DetectError::InvalidParameter {
-                name: "scratch",
-                expected: "the shared area switched to the detector",
-            }),
+            SharedScratch::$Variant(scratch) => Some(scratch),
+            _ => None,
+        }
+    }};
+}
+
+/// The error of a scratch area that did not switch (never: [`scratch_in`] just did).
+const NOT_SWITCHED: DetectError = DetectError::InvalidParameter {
+    name: "scratch",
+    expected: "the shared area switched to the detector",
+};
+
+/// Runs detector `$params` in the `$Variant` of a [`SharedScratch`].
+macro_rules! run_in {
+    ($shared:expr, $Variant:ident, $params:expr, $frame:expr) => {{
+        match scratch_in!($shared, $Variant) {
+            Some(scratch) => Detector::detect(&$params, $frame, scratch),
+            None => Err(NOT_SWITCHED),
         }
     }};
 }
@@ -112,6 +124,28 @@ impl Detectors {
     pub fn track(&mut self, prior: Roi, frame: &Frame<'_>) -> Result<Detection, DetectError> {
         let params = Auto::default().with_prior(Some(prior));
         run_in!(&mut self.shared, Auto, params, frame)
+    }
+
+    /// Runs `auto` (tracking `prior` if given) within a work budget in Cortex-M7
+    /// instructions ([`Auto::detect_within`]): its best box so far and where it stopped
+    /// when the budget does not cover every stage.
+    ///
+    /// Never inlined, for the same reason as [`Detectors::run`].
+    ///
+    /// # Errors
+    /// [`DetectError`] when the default parameters are refused (never).
+    #[inline(never)]
+    pub fn auto_within(
+        &mut self,
+        prior: Option<Roi>,
+        frame: &Frame<'_>,
+        budget: WorkBudget,
+    ) -> Result<(Detection, BudgetReport), DetectError> {
+        let params = Auto::default().with_prior(prior);
+        match scratch_in!(&mut self.shared, Auto) {
+            Some(scratch) => params.detect_within(frame, scratch, budget),
+            None => Err(NOT_SWITCHED),
+        }
     }
 }
 

@@ -22,6 +22,8 @@ pub mod detectors;
 pub mod frames;
 pub mod report;
 pub mod synth;
+#[cfg(all(target_arch = "arm", target_os = "none"))]
+pub mod systick;
 
 use core::hint::black_box;
 

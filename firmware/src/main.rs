@@ -3,11 +3,10 @@
 //! defmt frames with `--features defmt`), with the instructions and the stack depth
 //! of each step, then exits through semihosting with status 0, or 1 if a step failed.
 //!
-//! Instructions: the SysTick counts the processor clock; under `qemu-system-arm
-//! -icount shift=0` every guest instruction advances the virtual clock by 1 ns, and the
-//! mps2 boards clock the SysTick at 25 MHz, so a SysTick tick is 40 instructions
-//! ([`INSTRUCTIONS_PER_TICK`], checked at start-up against a loop of known length).
-//! The counter's own cost is measured and subtracted. Counts are exact to ± 40.
+//! Instructions: counted with the SysTick ([`tirroi_firmware::systick`]: 40
+//! instructions per tick under `qemu-system-arm -icount shift=0`, checked at start-up
+//! against a loop of known length). The counter's own cost is measured and subtracted.
+//! Counts are exact to ± 40.
 //!
 //! Stack: before each step the free RAM between the end of the statics and the stack
 //! pointer is painted with a pattern; after it, the lowest overwritten word gives the
@@ -16,52 +15,20 @@
 
 #[cfg(target_os = "none")]
 mod target {
-    use core::sync::atomic::{AtomicU32, Ordering};
-
-    use cortex_m::peripheral::SYST;
-    use cortex_m::peripheral::syst::SystClkSource;
-    use cortex_m_rt::{entry, exception};
+    use cortex_m_rt::entry;
     #[cfg(feature = "defmt")]
     use defmt_semihosting as _;
     use panic_semihosting as _;
     use tirroi_core::frame::FRAME_PIXELS;
     use tirroi_firmware::synth::Tables;
+    use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{Detectors, Event, Meter, MeterReading, Workspace, run_demo};
 
-    /// Instructions per SysTick tick under `-icount shift=0` (1 ns per instruction,
-    /// SysTick at the 25 MHz system clock of the mps2 boards).
-    const INSTRUCTIONS_PER_TICK: u64 = 40;
-    /// The SysTick reload value: the full 24 bits.
-    const RELOAD: u32 = 0x00FF_FFFF;
     /// The stack paint pattern.
     const PAINT: u32 = 0xC5AC_CE55;
     /// Bytes below the stack pointer left unpainted when a measurement starts (the
     /// painting function's own frame).
     const PAINT_MARGIN: usize = 64;
-
-    /// SysTick wraps since start-up (written by the SysTick handler only).
-    static WRAPS: AtomicU32 = AtomicU32::new(0);
-
-    #[exception]
-    fn SysTick() {
-        // Single writer: a load and a store are enough, and ARMv6-M has no RMW atomics.
-        WRAPS.store(
-            WRAPS.load(Ordering::Relaxed).wrapping_add(1),
-            Ordering::Relaxed,
-        );
-    }
-
-    /// SysTick ticks since start-up, 64-bit.
-    fn ticks() -> u64 {
-        loop {
-            let before = WRAPS.load(Ordering::SeqCst);
-            let current = SYST::get_current();
-            let after = WRAPS.load(Ordering::SeqCst);
-            if before == after {
-                return u64::from(before) * (u64::from(RELOAD) + 1) + u64::from(RELOAD - current);
-            }
-        }
-    }
 
     unsafe extern "C" {
         /// End of the statics (.bss / .uninit), from cortex-m-rt's link.x: the bottom
@@ -161,8 +128,7 @@ mod target {
         #[inline(never)]
         fn stop(&mut self) -> MeterReading {
             let end = ticks();
-            let instructions =
-                ((end - self.start_ticks) * INSTRUCTIONS_PER_TICK).saturating_sub(self.overhead);
+            let instructions = systick::instructions(self.start_ticks, end, self.overhead);
             MeterReading {
                 instructions: Some(instructions),
                 stack_bytes: Some(self.stack_used()),
@@ -170,7 +136,7 @@ mod target {
         }
     }
 
-    /// Checks [`INSTRUCTIONS_PER_TICK`]: counts a loop of 2 instructions × N.
+    /// Checks [`systick::INSTRUCTIONS_PER_TICK`]: counts a loop of 2 instructions × N.
     fn calibrate(meter: &mut QemuMeter) -> (u64, u64) {
         const ITERATIONS: u32 = 1_000_000;
         meter.start();
@@ -261,11 +227,7 @@ mod target {
         static mut TABLES: Tables = Tables::new();
 
         let mut core = cortex_m::Peripherals::take().expect("first and only take");
-        core.SYST.set_clock_source(SystClkSource::Core);
-        core.SYST.set_reload(RELOAD);
-        core.SYST.clear_current();
-        core.SYST.enable_interrupt();
-        core.SYST.enable_counter();
+        systick::start(&mut core.SYST);
 
         let mut meter = QemuMeter::new();
         let (expected, counted) = calibrate(&mut meter);

@@ -6,6 +6,7 @@
 //! ```text
 //! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248
 //! worst case=checker-7 method=auto+prior prior=0,0,16,16 instructions=612400 box=none
+//! worst case=checker-7 method=auto-budget prior=none budget=1310720 instructions=1012440 charged=1290232 stopped=refinement box=40,8,72,40
 //! ```
 //!
 //! then `worst done calls=N` and exit 0 (1 if a detector refused its input).
@@ -17,46 +18,16 @@
 #[cfg(target_os = "none")]
 mod target {
     use core::hint::black_box;
-    use core::sync::atomic::{AtomicU32, Ordering};
 
-    use cortex_m::peripheral::SYST;
-    use cortex_m::peripheral::syst::SystClkSource;
-    use cortex_m_rt::{entry, exception};
+    use cortex_m_rt::entry;
     use cortex_m_semihosting::{debug, hprintln};
     use panic_semihosting as _;
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+    use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
     use tirroi_core::{DetectError, Detection, Frame, Method};
     use tirroi_firmware::adversarial::{self, PRIORS};
+    use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
-
-    /// Instructions per SysTick tick under `-icount shift=0` (as in src/main.rs).
-    const INSTRUCTIONS_PER_TICK: u64 = 40;
-    /// The SysTick reload value: the full 24 bits.
-    const RELOAD: u32 = 0x00FF_FFFF;
-
-    /// SysTick wraps since start-up (written by the SysTick handler only).
-    static WRAPS: AtomicU32 = AtomicU32::new(0);
-
-    #[exception]
-    fn SysTick() {
-        WRAPS.store(
-            WRAPS.load(Ordering::Relaxed).wrapping_add(1),
-            Ordering::Relaxed,
-        );
-    }
-
-    /// SysTick ticks since start-up, 64-bit.
-    #[inline(never)]
-    fn ticks() -> u64 {
-        loop {
-            let before = WRAPS.load(Ordering::SeqCst);
-            let current = SYST::get_current();
-            let after = WRAPS.load(Ordering::SeqCst);
-            if before == after {
-                return u64::from(before) * (u64::from(RELOAD) + 1) + u64::from(RELOAD - current);
-            }
-        }
-    }
 
     /// Instructions of `f`, less `overhead` (an empty measurement's).
     #[inline(always)]
@@ -64,10 +35,7 @@ mod target {
         let start = ticks();
         let r = black_box(f());
         let end = ticks();
-        (
-            r,
-            ((end - start) * INSTRUCTIONS_PER_TICK).saturating_sub(overhead),
-        )
+        (r, systick::instructions(start, end, overhead))
     }
 
     /// A detection's box as `x0,y0,x1,y1`, `none`, or `error` (so runs can be
@@ -86,6 +54,35 @@ mod target {
         }
     }
 
+    /// The budget ladder of `auto-budget` lines: 0/8 .. 7/8 of the full charge.
+    const BUDGET_STEPS: u32 = 8;
+
+    /// A prior as `x0,y0,x1,y1`, or `none`.
+    struct PriorOf(Option<tirroi_core::Roi>);
+
+    impl core::fmt::Display for PriorOf {
+        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            match self.0 {
+                Some(r) => write!(f, "{},{},{},{}", r.x0, r.y0, r.x1, r.y1),
+                None => f.write_str("none"),
+            }
+        }
+    }
+
+    /// Where a budgeted call stopped: `no` (it ran to the end) or the stage that did
+    /// not fit, `+tracking` when after a tracking pass.
+    struct StopOf<'a>(&'a BudgetReport);
+
+    impl core::fmt::Display for StopOf<'_> {
+        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            match self.0.stopped {
+                None => f.write_str("no"),
+                Some(s) if s.after_tracking => write!(f, "{}+tracking", s.stage.name()),
+                Some(s) => f.write_str(s.stage.name()),
+            }
+        }
+    }
+
     #[entry]
     fn main() -> ! {
         // Statics via cortex-m-rt's `static mut` in the entry function (safe references).
@@ -93,11 +90,7 @@ mod target {
         static mut DETECTORS: Detectors = Detectors::new();
 
         let mut core = cortex_m::Peripherals::take().expect("first and only take");
-        core.SYST.set_clock_source(SystClkSource::Core);
-        core.SYST.set_reload(RELOAD);
-        core.SYST.clear_current();
-        core.SYST.enable_interrupt();
-        core.SYST.enable_counter();
+        systick::start(&mut core.SYST);
 
         let overhead = (0..8).map(|_| count(0, || ()).1).min().unwrap_or(0);
         hprintln!("worst overhead={overhead} cases={}", adversarial::COUNT);
@@ -135,6 +128,43 @@ mod target {
                         prior.y1,
                         BoxOf(&result)
                     );
+                }
+            }
+            // `auto` within a work budget: without a prior and with each prior, the
+            // whole pipeline's charge, then budgets of 0/8 .. 7/8 of it. Each line has
+            // the budget, the instructions counted and charged (scripts/worst-case.sh
+            // checks counted <= charged <= budget) and where the call stopped.
+            if DEMO_METHODS.contains(&Method::Auto) {
+                for prior in core::iter::once(None).chain(PRIORS.iter().copied().map(Some)) {
+                    let full = DETECTORS.auto_within(prior, &frame, WorkBudget::UNLIMITED);
+                    let Ok((_, all)) = full else {
+                        failed = true;
+                        continue;
+                    };
+                    for eighth in (0..=BUDGET_STEPS).rev() {
+                        let budget = if eighth == BUDGET_STEPS {
+                            WorkBudget::UNLIMITED
+                        } else {
+                            let b = u64::from(all.charged) * u64::from(eighth)
+                                / u64::from(BUDGET_STEPS);
+                            WorkBudget::instructions(b as u32)
+                        };
+                        let (result, n) =
+                            count(overhead, || DETECTORS.auto_within(prior, &frame, budget));
+                        calls += 1;
+                        let Ok((d, report)) = result else {
+                            failed = true;
+                            continue;
+                        };
+                        hprintln!(
+                            "worst case={case} method=auto-budget prior={} budget={} instructions={n} charged={} stopped={} box={}",
+                            PriorOf(prior),
+                            budget.instructions,
+                            report.charged,
+                            StopOf(&report),
+                            BoxOf(&Ok(d))
+                        );
+                    }
                 }
             }
         }

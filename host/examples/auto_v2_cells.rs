@@ -4,12 +4,14 @@
 //! `cargo run --release -p tirroi-host --example auto_v2_cells -- features DIR OUT.csv`
 //! writes, for every frame of a dataset rendered with `--masks`, one line per 8×8 cell:
 //! `frame,cx,cy,coverage,f0..f20` (coverage: the mean of the cell's mask values,
-//! 0–255, i.e. the share of the cell covered by the target × 255).
+//! 0–255, i.e. the share of the cell covered by the target × 255; for a dataset without
+//! `masks/`, e.g. `tirroi fixtures --count N --seed S`, the truth box stands for the mask).
 //!
 //! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
 //! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
-//! boxed: the confidence model's training data).
+//! boxed: the confidence model's training data). An optional last argument sets
+//! the cell threshold (`AutoV2::cell_score`, score units).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -19,14 +21,28 @@ use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, AutoV2Work, for_each_cell_features};
 use tirroi_host::imaging::image_io::read_frame;
 
-fn frames(dir: &Path) -> Vec<(String, u8)> {
+/// A frame of the dataset: file, bit depth, and the truth box (½ convention; `None`
+/// without a target).
+type Entry = (String, u8, Option<[usize; 4]>);
+
+fn frames(dir: &Path) -> Vec<Entry> {
     let meta = std::fs::read_to_string(dir.join("metadata.jsonl")).expect("metadata.jsonl");
     meta.lines()
         .map(|l| {
             let v: serde_json::Value = serde_json::from_str(l).expect("json");
+            let bbox = v["bbox"].as_array().and_then(|b| {
+                let c: Vec<usize> = b
+                    .iter()
+                    .filter_map(|x| x.as_u64())
+                    .map(|x| x as usize)
+                    .collect();
+                (c.len() == 4 && v["target"].as_str() != Some("none"))
+                    .then(|| [c[0], c[1], c[2], c[3]])
+            });
             (
                 v["file"].as_str().expect("file").to_string(),
                 v["bits"].as_u64().unwrap_or(14) as u8,
+                bbox,
             )
         })
         .collect()
@@ -35,11 +51,19 @@ fn frames(dir: &Path) -> Vec<(String, u8)> {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (mode, dir, out) = (&args[1], PathBuf::from(&args[2]), PathBuf::from(&args[3]));
+    // Optional: the cell threshold, score units (default: `AutoV2::default()`'s).
+    let cell_score = args
+        .get(4)
+        .map(|v| {
+            v.parse::<i16>()
+                .expect("cell_score: an integer, score units")
+        })
+        .unwrap_or(AutoV2::default().cell_score);
     let list = frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
         .enumerate()
-        .map(|(i, (file, bits))| {
+        .map(|(i, (file, bits, bbox))| {
             let f = read_frame(&dir.join(file), Some(*bits)).expect("frame");
             let frame = f.view().expect("view");
             let mut s = String::new();
@@ -56,6 +80,18 @@ fn main() {
                                 n += 1;
                             }
                         }
+                    } else if let Some([x0, y0, x1, y1]) = bbox {
+                        // Without masks (the test-set kinds): the truth box as the mask.
+                        for y in cy * 8..cy * 8 + 8 {
+                            for x in cx * 8..cx * 8 + 8 {
+                                cov += if (*x0..*x1).contains(&x) && (*y0..*y1).contains(&y) {
+                                    255
+                                } else {
+                                    0
+                                };
+                                n += 1;
+                            }
+                        }
                     }
                     let _ = write!(s, "{i},{cx},{cy},{}", cov / n.max(1));
                     for v in feats {
@@ -67,7 +103,12 @@ fn main() {
                 let mut scratch = Box::new(AutoV2Scratch::new());
                 // `predict-all`: every winner (the confidence model's training data).
                 let gate_off = AutoV2 {
-                    min_score_permille: if mode == "predict-all" { 0 } else { 500 },
+                    min_score_permille: if mode == "predict-all" {
+                        0
+                    } else {
+                        AutoV2::default().min_score_permille
+                    },
+                    cell_score,
                     ..AutoV2::default()
                 };
                 let d = gate_off.detect(&frame, &mut scratch).expect("detect");

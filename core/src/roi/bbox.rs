@@ -66,6 +66,18 @@ impl Roi {
         x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
     }
 
+    /// Row `y` of the box's filled mask into `row` (pixel x of the row at `row[x]`):
+    /// true inside the box, false elsewhere; the box is cut to the row's length.
+    pub fn fill_mask_row(&self, y: usize, row: &mut [bool]) {
+        row.fill(false);
+        if self.contains(self.x0, y.min(usize::from(u16::MAX)) as u16) {
+            let x1 = usize::from(self.x1).min(row.len());
+            if let Some(inside) = row.get_mut(usize::from(self.x0).min(x1)..x1) {
+                inside.fill(true);
+            }
+        }
+    }
+
     /// True when `other` lies entirely inside `self` (an empty `other` always does).
     pub const fn contains_roi(&self, other: &Roi) -> bool {
         other.is_empty()
@@ -128,6 +140,24 @@ impl Roi {
 #[cfg(test)]
 mod tests {
     use super::Roi;
+
+    #[test]
+    fn mask_rows_are_the_box_pixel_by_pixel() {
+        let mut row = [true; 12];
+        for roi in [
+            Roi::new(2, 1, 7, 4),
+            Roi::new(9, 0, 30, 2), // wider than the row: cut
+            Roi::new(5, 5, 3, 8),  // empty
+            Roi::EMPTY,
+        ] {
+            for y in 0..6 {
+                roi.fill_mask_row(y, &mut row);
+                for (x, &m) in row.iter().enumerate() {
+                    assert_eq!(m, roi.contains(x as u16, y as u16), "{roi:?} ({x}, {y})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn area_iou_and_clip() {

@@ -155,10 +155,12 @@ impl BandLut {
         let mantissa = (bits & 0x007f_ffff) as f32 * (1.0 / 8_388_608.0);
         let guess = (exponent as f32 + mantissa) * LUT_NODES_PER_OCTAVE as f32;
         let mut i = (guess.max(0.0) as usize).min(LUT_INTERVALS - 1);
+        // Checked reads (no panic path in the flight build); `i` stays in the table.
+        let start_k = |j: usize| self.intervals.get(j).map_or(f32::INFINITY, |iv| iv.t_k);
         for _ in 0..8 {
-            if i > 0 && t_k < self.intervals[i].t_k {
+            if i > 0 && t_k < start_k(i) {
                 i -= 1;
-            } else if i + 1 < LUT_INTERVALS && t_k >= self.intervals[i + 1].t_k {
+            } else if i + 1 < LUT_INTERVALS && t_k >= start_k(i + 1) {
                 i += 1;
             } else {
                 break;
@@ -178,7 +180,8 @@ impl BandLut {
         if t_k < LUT_T_MIN_K {
             return Ok(0.0);
         }
-        let iv = &self.intervals[self.index(t_k)];
+        // `index` is below LUT_INTERVALS; the `min` lets the compiler see it.
+        let iv = &self.intervals[self.index(t_k).min(LUT_INTERVALS - 1)];
         let u = (t_k - iv.t_k) * iv.inv_width_k;
         let u2 = u * u;
         let u3 = u2 * u;
@@ -199,8 +202,10 @@ impl BandLut {
         // The true L lies between the two correctly rounded node values; clamping to
         // them only removes error, and makes the end of one interval meet the start
         // of the next without a one-ulp step down.
+        // (max then min: `clamp`'s result for node values in order, without its
+        // panic branch for unordered bounds.)
         let l = if u <= 1.0 {
-            l.clamp(iv.l, iv.l_next)
+            l.max(iv.l).min(iv.l_next)
         } else {
             l.max(iv.l_next)
         };

@@ -353,10 +353,7 @@ impl BandRadiance {
         }
         let inv_t = 1.0 / t_k;
         let mut sum = 0.0;
-        for (x, w) in self.x_t_k[..self.nodes]
-            .iter()
-            .zip(&self.weight[..self.nodes])
-        {
+        for (x, w) in self.x_t_k.iter().zip(&self.weight).take(self.nodes) {
             sum += w / libm::expm1(x * inv_t);
         }
         sum
@@ -409,10 +406,7 @@ impl BandRadiance {
         // d/dT [1/(eˣ − 1)] = x eˣ/(eˣ − 1)² / T = x / (expm1(x)·(−expm1(−x))) / T.
         let inv_t = 1.0 / t_k;
         let mut sum = 0.0;
-        for (x_t, w) in self.x_t_k[..self.nodes]
-            .iter()
-            .zip(&self.weight[..self.nodes])
-        {
+        for (x_t, w) in self.x_t_k.iter().zip(&self.weight).take(self.nodes) {
             let x = x_t * inv_t;
             let em = libm::expm1(x);
             // Past exp overflow (x > 709.8) the term is below 1e-300: drop it rather

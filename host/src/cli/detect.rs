@@ -10,6 +10,8 @@ use super::EXIT_BAD_INPUT;
 use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
 use crate::imaging::image_io::{ReadOptions, parse_crop, read_frame_with};
+use tirroi_core::Method;
+use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
 
 /// The options of `tirroi detect`.
 #[derive(Debug, clap::Args)]
@@ -40,6 +42,13 @@ pub struct DetectArgs {
     /// boxes are in the cropped frame.
     #[arg(long, value_parser = parse_crop)]
     pub crop: Option<[usize; 4]>,
+    /// `auto` only: run it within this work budget, in Cortex-M7 instructions
+    /// (`Auto::detect_within`: each stage's worst case is charged before it runs; when
+    /// the next does not fit, the best box so far). Adds what was charged and where it
+    /// stopped to each `auto` line; the other methods run as without it. Frames up to
+    /// 328x248.
+    #[arg(long, value_name = "INSTRUCTIONS")]
+    pub budget: Option<u32>,
     /// Frames to process (PNG, TIFF or FITS).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -56,6 +65,32 @@ struct DetectLine<'a> {
     bbox: Option<[u16; 4]>,
     score: f32,
     time_us: f64,
+    /// With `--budget`, on `auto` lines only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    budget: Option<BudgetLine>,
+}
+
+/// What a budgeted `auto` call spent: `{"instructions","charged","stopped"}`, `stopped`
+/// the stage that did not fit (`noise`, `step-plane`, `candidates`, `refinement`, with
+/// `+tracking` after a tracking pass) or `null` when it ran to its end.
+#[derive(Debug, Serialize)]
+struct BudgetLine {
+    instructions: u32,
+    charged: u32,
+    stopped: Option<String>,
+}
+
+impl BudgetLine {
+    fn new(budget: WorkBudget, report: &BudgetReport) -> Self {
+        BudgetLine {
+            instructions: budget.instructions,
+            charged: report.charged,
+            stopped: report.stopped.map(|s| {
+                let tracking = if s.after_tracking { "+tracking" } else { "" };
+                format!("{}{tracking}", s.stage.name())
+            }),
+        }
+    }
 }
 
 /// Runs `tirroi detect`: every method on every frame, one line (or JSON object) each.
@@ -102,10 +137,22 @@ pub fn run(args: &DetectArgs) -> ExitCode {
             }
         };
         for &method in methods {
-            let (d, time_us) = match bank.detect_timed(method, &view, repeat) {
+            let budget = args
+                .budget
+                .filter(|_| method == Method::Auto)
+                .map(WorkBudget::instructions);
+            let timed = match budget {
+                Some(b) => bank
+                    .auto_within_timed(&view, b, repeat)
+                    .map(|(d, report, t)| (d, t, Some(BudgetLine::new(b, &report)))),
+                None => bank
+                    .detect_timed(method, &view, repeat)
+                    .map(|(d, t)| (d, t, None)),
+            };
+            let (d, time_us, spent) = match timed {
                 Ok(r) => r,
                 Err(e) => {
-                    eprintln!("tirroi: error: {method}: {e}");
+                    eprintln!("tirroi: error: {}: {method}: {e}", path.display());
                     return ExitCode::from(EXIT_BAD_INPUT);
                 }
             };
@@ -117,6 +164,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     bbox: d.roi.map(|r| r.to_array()),
                     score: d.score(),
                     time_us: (time_us * 1000.0).round() / 1000.0,
+                    budget: spent,
                 };
                 serde_json::to_string(&line)
                     .map_err(std::io::Error::other)
@@ -126,9 +174,19 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     .roi
                     .map(|r| format!("{:?}", r.to_array()))
                     .unwrap_or_else(|| "none".into());
+                let spent = spent
+                    .map(|b| {
+                        format!(
+                            "  budget {} charged {} stopped {}",
+                            b.instructions,
+                            b.charged,
+                            b.stopped.as_deref().unwrap_or("no")
+                        )
+                    })
+                    .unwrap_or_default();
                 writeln!(
                     out,
-                    "{file}  {:<8}  bbox {bbox:<22}  score {:.3}  {time_us:>9.1} us  threshold {}  foreground {} px",
+                    "{file}  {:<8}  bbox {bbox:<22}  score {:.3}  {time_us:>9.1} us  threshold {}  foreground {} px{spent}",
                     method.name(),
                     d.score(),
                     d.threshold,

@@ -3,6 +3,7 @@
 use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
+use tirroi_core::roi::auto::{AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method, Roi};
 
@@ -16,6 +17,8 @@ pub struct DetectorBank {
     scratch: Box<Detectors>,
     scratch_640x512: Option<Box<Detectors<Cap640x512>>>,
     scratch_1024x768: Option<Box<Detectors<Cap1024x768>>>,
+    /// `auto`'s scratch for budgeted calls (328×248), made on the first one.
+    auto_budgeted: Option<Box<AutoScratch>>,
 }
 
 /// True when `frame` fits capacity `C`.
@@ -31,6 +34,7 @@ impl Default for DetectorBank {
             scratch: Box::new(Detectors::new()),
             scratch_640x512: None,
             scratch_1024x768: None,
+            auto_budgeted: None,
         }
     }
 }
@@ -119,6 +123,41 @@ impl DetectorBank {
             timed()?;
         }
         Ok((detection, median(&mut times)))
+    }
+}
+
+impl DetectorBank {
+    /// Runs `auto` (its parameters here, prior included) within `budget` Cortex-M7
+    /// instructions (`Auto::detect_within`) `repeat` times (at least once): the
+    /// detection, what it charged and where it stopped, and the median wall time of the
+    /// core call alone, in microseconds.
+    ///
+    /// # Errors
+    /// The core's [`DetectError`]: parameters out of bounds, or a frame above 328×248
+    /// (budgeted calls run at the flight capacity only).
+    pub fn auto_within_timed(
+        &mut self,
+        frame: &Frame<'_>,
+        budget: WorkBudget,
+        repeat: usize,
+    ) -> Result<(Detection, BudgetReport, f64), DetectError> {
+        let auto = match self.params[Method::Auto.index()] {
+            Params::Auto(auto) => auto,
+            _ => Default::default(),
+        };
+        let scratch = self.auto_budgeted.get_or_insert_with(Box::default);
+        let mut times = Vec::with_capacity(repeat.max(1));
+        let mut timed = || -> Result<(Detection, BudgetReport), DetectError> {
+            let start = Instant::now();
+            let r = auto.detect_within(frame, scratch, budget)?;
+            times.push(start.elapsed().as_secs_f64() * 1e6);
+            Ok(r)
+        };
+        let (d, report) = timed()?;
+        for _ in 1..repeat {
+            timed()?;
+        }
+        Ok((d, report, median(&mut times)))
     }
 }
 

@@ -59,9 +59,14 @@
 //!
 //! No heap; integer arithmetic only in every loop over pixels and cells (no floating
 //! point at all); no panic on any frame (`Frame` bounds every access; proptest and a
-//! fuzz target check it); memory [`SCRATCH_BYTES`] (≤ 32 KiB, checked at compile
-//! time).
+//! fuzz target check it; the flight build links without a panic path,
+//! `scripts/panic-never.sh`); memory [`SCRATCH_BYTES`] (≤ 32 KiB, checked at compile
+//! time). Time: [`Auto::detect_within`] takes a [`WorkBudget`] in Cortex-M7
+//! instructions, charges each stage's worst case before it runs and stops with its
+//! best box so far when the next stage does not fit (module `budget`), so a frame
+//! never overruns its slot.
 
+pub mod budget;
 mod decision;
 mod edges;
 pub mod learned;
@@ -71,12 +76,14 @@ pub mod rules;
 mod steps;
 mod tracking;
 
+pub use budget::{AutoStage, BudgetReport, CALL_INSTR, Stopped, WorkBudget, largest_charge};
 pub use edges::MAX_EDGE_COMPONENTS;
 
 use super::plane::{BLOCK, Window};
 use super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
 use crate::capacity::{ConstInit, FrameCapacity, Reference};
 use crate::frame::{FRAME_WIDTH, Frame};
+use budget::{Ledger, coarse_box};
 use decision::choose_target;
 use edges::{EdgeComponents, label_edge_cells};
 use noise::{NOISE_BINS, noise_sigma};
@@ -210,12 +217,16 @@ struct Found {
 }
 
 impl Auto {
-    /// Runs the pipeline's stages on `win`; `None` when no component is found.
+    /// Runs the pipeline's stages on `win`; `None` when no component is found. Each
+    /// stage is charged to `ledger` first; when one does not fit, the pass stops: no
+    /// box before the candidates, the winner's cell box ([`coarse_box`]) when the
+    /// refinement does not fit.
     fn locate<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoWork<C>,
         win: Window,
+        ledger: &mut Ledger,
     ) -> Option<Found> {
         let AutoWork {
             step_codes,
@@ -237,10 +248,16 @@ impl Auto {
         };
         let (pixel_row, flag_row) = (pixel_row.as_mut(), flag_row.as_mut());
         // 1. Noise and scene.
+        if !ledger.noise(win) {
+            return None;
+        }
         let noise = noise_sigma(frame, win, hist, pixel_row);
         // 2. Step plane (codes below the edge threshold's are not worked out).
         let edge_code = step_code(u32::from(self.coarse_sigma) * STEP_UNITS_PER_SIGMA);
         let floor = step_value(edge_code);
+        if !ledger.step_plane(win, cells) {
+            return None;
+        }
         step_plane(
             frame,
             win,
@@ -251,6 +268,9 @@ impl Auto {
             step_codes,
         );
         // 3. Candidates: edge components.
+        if !ledger.candidates(cells) {
+            return None;
+        }
         let next = label_edge_cells(
             step_codes,
             labels,
@@ -263,6 +283,14 @@ impl Auto {
         let (root, winner) = choose_target(comps, next, plane, self.side_shift)?;
         // 5. Refinement: the gate (the labels become it), saturation counts.
         let region = Region::around(&winner, win);
+        let threshold = u32::from(self.coarse_sigma) * noise.sigma;
+        if !ledger.refinement(&region) {
+            return Some(Found {
+                roi: Some(coarse_box(win, &winner)),
+                threshold,
+                edge_px: 0,
+            });
+        }
         let (row_dilated, winner_row) = (step_codes, flag_row);
         let gate = build_gate(
             labels,
@@ -295,7 +323,7 @@ impl Auto {
         let (roi, edge_px) = outline(frame, &gate, &region, noise, tau, saturated, &counts);
         roi.map(|roi| Found {
             roi: Some(roi),
-            threshold: u32::from(self.coarse_sigma) * noise.sigma,
+            threshold,
             edge_px,
         })
     }
@@ -413,14 +441,11 @@ impl Detector for Auto {
         work: &mut AutoWork<C>,
         mut sink: F,
     ) -> u32 {
-        let d = self.run(frame, work);
+        let d = self.run(frame, work, &mut Ledger::new(WorkBudget::UNLIMITED));
         let roi = d.roi.unwrap_or(Roi::EMPTY);
         let mask_row = &mut work.flag_row.as_mut()[..frame.width()];
         for y in 0..frame.height() {
-            mask_row.fill(false);
-            if roi.contains(roi.x0, y as u16) {
-                mask_row[usize::from(roi.x0)..usize::from(roi.x1)].fill(true);
-            }
+            roi.fill_mask_row(y, mask_row);
             sink(y, mask_row);
         }
         d.threshold
@@ -435,7 +460,36 @@ impl Detector for Auto {
     ) -> Result<Detection, DetectError> {
         self.validate()?;
         DetectError::check_capacity::<C>(frame)?;
-        Ok(self.run(frame, &mut scratch.work))
+        Ok(self.run(
+            frame,
+            &mut scratch.work,
+            &mut Ledger::new(WorkBudget::UNLIMITED),
+        ))
+    }
+}
+
+impl Auto {
+    /// Runs `auto` within a work budget (module `budget` explains the charges):
+    /// the same answer as [`Detector::detect`] when the budget covers every stage's
+    /// charge, else the best box so far (the tracking pass's box, else the winner's
+    /// cell box when only the refinement did not fit, else none) with
+    /// [`BudgetReport::stopped`] saying where it stopped. The work done stays within
+    /// the charges ([`BudgetReport::charged`] ≤ the budget, or [`CALL_INSTR`] for a
+    /// budget below it).
+    ///
+    /// # Errors
+    /// As [`Detector::detect`]: invalid parameters, a frame over the capacity.
+    pub fn detect_within<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        scratch: &mut Scratch<AutoWork<C>, C>,
+        budget: WorkBudget,
+    ) -> Result<(Detection, BudgetReport), DetectError> {
+        self.validate()?;
+        DetectError::check_capacity::<C>(frame)?;
+        let mut ledger = Ledger::new(budget);
+        let d = self.run(frame, &mut scratch.work, &mut ledger);
+        Ok((d, ledger.report()))
     }
 }
 

@@ -5,18 +5,23 @@
 
 use super::super::Detection;
 use super::super::plane::Window;
+use super::budget::Ledger;
 use super::{Auto, AutoWork, Found};
 use crate::capacity::FrameCapacity;
 use crate::frame::Frame;
 
 impl Auto {
-    /// The detection (box, coarse threshold, edge pixels), tracking window first.
+    /// The detection (box, coarse threshold, edge pixels), tracking window first, each
+    /// stage charged to `ledger` (a stop returns the best box so far: the tracking
+    /// pass's box, else the full pass's coarse box, else none).
     pub(super) fn run<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoWork<C>,
+        ledger: &mut Ledger,
     ) -> Detection {
         let full = Window::full(frame);
+        let mut tracked = None;
         if let Some(p) = self.prior {
             let p = p.clip(frame.width() as u16, frame.height() as u16);
             if !p.is_empty() {
@@ -31,7 +36,11 @@ impl Auto {
                     usize::from(p.y1) + m,
                 );
                 if let Some(win) = win.filter(|w| !w.is_full(frame)) {
-                    if let Some(f) = self.locate(frame, work, win) {
+                    let found = self.locate(frame, work, win, ledger);
+                    if ledger.is_stopped() {
+                        return found.map_or(NO_DETECTION, detection);
+                    }
+                    if let Some(f) = found {
                         // Still the tracked target: the box overlaps the prior and is
                         // not cut by the window (a side on the window's border is one
                         // the frame's border, or the target left the window).
@@ -48,21 +57,31 @@ impl Auto {
                         if kept {
                             return detection(f);
                         }
+                        // The best box so far should the full pass not fit: the
+                        // tracked target cut by the window (not a box beside it).
+                        if f.roi.is_some_and(|r| !r.intersection(&p).is_empty()) {
+                            tracked = Some(f);
+                        }
                     }
+                    ledger.tracking_done();
                 }
             }
         }
-        match self.locate(frame, work, full) {
-            Some(f) => detection(f),
-            None => Detection {
-                roi: None,
-                threshold: 0,
-                foreground_px: 0,
-                score_permille: 0,
-            },
+        let found = self.locate(frame, work, full, ledger);
+        match (ledger.is_stopped(), tracked) {
+            (true, Some(t)) => detection(t),
+            _ => found.map_or(NO_DETECTION, detection),
         }
     }
 }
+
+/// No box.
+const NO_DETECTION: Detection = Detection {
+    roi: None,
+    threshold: 0,
+    foreground_px: 0,
+    score_permille: 0,
+};
 
 fn detection(f: Found) -> Detection {
     Detection {
