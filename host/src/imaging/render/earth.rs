@@ -29,7 +29,8 @@ pub const LIMB_EDGE_SCALE_HEIGHT_M: f64 = 6.0e3;
 pub const LIMB_EDGE_TOP_M: f64 = 60.0e3;
 
 /// Lowest brightness temperature of the dense cloud-texture radiance table, K (below
-/// the coldest cloud top the texture makes: clear surface − [`MAX_LOCAL_COLD_K`] ≥ ~180 K).
+/// the texture's cloud tops but for the deepest cores, clear surface − [`MAX_LOCAL_COLD_K`],
+/// which fall back to the [`BandLut`]).
 ///
 /// [`MAX_LOCAL_COLD_K`]: crate::world::earth::clouds::MAX_LOCAL_COLD_K
 pub const DENSE_RADIANCE_T_MIN_K: f32 = 150.0;

@@ -12,7 +12,7 @@
 //!   between cell centres, so no parameter jumps at cell borders): the share of clear
 //!   flux that is missing, r = 1 − F̃/F_clear, sets the cloud fraction
 //!   c = min(√(r / [`OVERCAST_DEFICIT`]), [`MAX_CLOUD_FRACTION`]) and a mean
-//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 15.5…40 K colder than
+//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 15.5…75 K colder than
 //!   the clear surface;
 //! - m = a steep smoothstep of (n − θ): n is a fractal field (value noise on the 3-D
 //!   unit sphere × Earth radius, so there is no seam and no pole singularity; octaves
@@ -26,13 +26,16 @@
 //!   [`DEEP_COARSE_WEIGHT`] and the [`MESOSCALE_OCTAVES`] take their variance, the edge
 //!   width grows with them, the tops are flat and carry their own texture
 //!   ([`CLOUD_TOP_TEXTURE_K`] per σ of the finer octaves): clusters and anvils instead of
-//!   one deck hundreds of km wide;
+//!   one deck hundreds of km wide; beyond [`EDGE_WIDTH_FULL_DEPTH_K`] a deck's edge
+//!   steps as a 40 K cloud and the rest of its depth comes inside it (cold cores,
+//!   [`DEEP_CORE_WIDTHS`] edge widths in);
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
 //!   (more or less cloud where the noise realisation has too little or too much); s
 //!   scales the whole temperature only for the rest δ cannot reach (within
-//!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`BORDER_BLEND_DEG`] of a cell border δ
-//!   and s blend with the neighbour's (smoothstep), so the field is continuous. Three
+//!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`SHIFT_BLEND_DEG`] (δ) and
+//!   [`BORDER_BLEND_DEG`] (s) of a cell border they blend with the neighbour's
+//!   (smoothstep), so the field is continuous. Three
 //!   passes, each lazy per cell: δ of the cell alone; δ again with the neighbours'
 //!   first δ blended in; s from the mean with every final δ blended as rendered.
 //!
@@ -91,17 +94,39 @@ pub const OVERCAST_DEFICIT: f64 = 0.3;
 pub const MAX_CLOUD_FRACTION: f64 = 0.95;
 /// Cloud tops are at least this much colder than the clear surface, K.
 pub const MIN_CLOUD_COLD_K: f64 = 15.5;
-/// ... and at most this much, K (deeper flux deficits come as more cloud, not colder).
-pub const MAX_CLOUD_COLD_K: f64 = 40.0;
-/// Cap of the texture's local depth ΔT_local, K (the coldest convective cores: lets the
-/// threshold shift balance the deepest cells without the scale s).
-pub const MAX_LOCAL_COLD_K: f64 = 48.0;
+/// ... and at most this much, K: deep-convective tops of 195–210 K over the Eq. 10
+/// clear sky of the tropics (~268 K), so that the deepest 1° cells of the built-in field
+/// (~100 W m⁻² at a cloud fraction of 0.95) are reached by the cloud partition itself.
+/// (Session 24: was 40 K; cells below ~150 W m⁻² then saturated their threshold shift
+/// at −[`MAX_THRESHOLD_SHIFT_SIGMA`] and the scale s took 3–7 % off the whole cell,
+/// blended with the neighbours' over only [`BORDER_BLEND_DEG`]: 1°-cell blocks with
+/// straight edges, 6–14 K steps along the borders.)
+pub const MAX_CLOUD_COLD_K: f64 = 75.0;
+/// Cap of the texture's local depth ΔT_local, K (the coldest convective cores with their
+/// top texture; the 80 K upper bound on cloud-top depth).
+pub const MAX_LOCAL_COLD_K: f64 = 80.0;
+/// Cloud depth ΔT beyond which the edge width stops growing and the edge stops
+/// deepening, K (the full deep-convective regime, [`DEEP_CONVECTION_FULL_K`]): growing
+/// on as ΔT^[`EDGE_WIDTH_DEPTH_EXPONENT`], the edges of the deepest decks would spread
+/// over several noise σ and the cloud field would fade into a uniform blend; stepping
+/// by the full ΔT, they would put too many 2-px steps above 10 K.
+pub const EDGE_WIDTH_FULL_DEPTH_K: f64 = 40.0;
+/// The depth a cloud top has beyond [`EDGE_WIDTH_FULL_DEPTH_K`] is reached this many
+/// edge widths inside the cloud (smoothstep): the deepest decks step at their edges as
+/// a 40 K cloud and get colder towards their cores (the coldest tops of convective
+/// clusters sit inside their anvils), so the 2-px steps at deck edges stay within the
+/// real convective scene's range.
+pub const DEEP_CORE_WIDTHS: f64 = 3.0;
 /// Peak-to-peak amplitude of the clear-sky grain (unresolved trade cumulus, surface
 /// and humidity texture), K.
 pub const CLEAR_GRAIN_K: f64 = 2.0;
-/// Half-width of the band along each cell border where (δ, s) blend with the
-/// neighbour cell's, degrees (0.05° ≈ 5.6 km of latitude: about 3 px at 4 km).
-pub const BORDER_BLEND_DEG: f64 = 0.05;
+/// Half-width of the band along each cell border where the scale s blends with the
+/// neighbour cell's, in cell fractions (0.15° ≈ 17 km of latitude: about 4 px at 4 km
+/// on each side). Session 24: was 0.05°; the deepest cells' s still differs from the
+/// neighbours' by up to ~1.7 % (their threshold shift at its bound), a ~3.5 K step at
+/// 210 K, which over 0.1° drew straight lines along the borders; over 0.3° it is a
+/// gradient of about 0.5 K per pixel, under the cloud texture's.
+pub const BORDER_BLEND_DEG: f64 = 0.15;
 /// Half-width of the band along each cell border where the cloud threshold shift
 /// blends with the neighbour's, degrees (0.35°: the threshold changes smoothly over
 /// 80 km, so no cloud is cut along a cell border).
@@ -112,8 +137,8 @@ pub const SHIFT_BLEND_DEG: f64 = 0.35;
 /// octaves as low clouds are single blobs hundreds of km wide, whose 2-D spectrum is
 /// steeper (−3.4…−3.7 over 8–200 km) than real convective scenes (−3.1).
 pub const DEEP_CONVECTION_ONSET_K: f64 = 25.0;
-/// Cloud depth ΔT at which the deep-convective regime is full, K (the deepest
-/// cloud-top depth, [`MAX_CLOUD_COLD_K`]).
+/// Cloud depth ΔT at which the deep-convective regime is full, K (deeper tops, up to
+/// [`MAX_CLOUD_COLD_K`], keep the full regime).
 pub const DEEP_CONVECTION_FULL_K: f64 = 40.0;
 /// Weight of the coarse (≥ 100 km) octaves in a full deep-convective regime: deep
 /// convection comes as clusters of 20–100 km cells and anvils, not as one deck.
@@ -133,8 +158,10 @@ pub const CLOUD_TOP_TEXTURE_K: f64 = 3.0;
 pub const CLOUD_TOP_TEXTURE_CLIP: f64 = 2.0;
 /// Sample points per axis of a cell's energy balance (16 × 16, cell-centred).
 pub const BALANCE_SAMPLES: usize = 16;
-/// Largest shift of a cell's cloud threshold its balance may use, noise σ.
-pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 6.0;
+/// Largest shift of a cell's cloud threshold its balance may use, noise σ (session 24:
+/// was 6; the deepest cells need their cores, [`DEEP_CORE_WIDTHS`] edge widths inside
+/// the clouds, over most of their area).
+pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 12.0;
 /// Margin of the local clear sky above the Eq. 10 temperature of the interpolated flux,
 /// K: where a cell is warmer than the clear-sky climatology its clear sky warms with it.
 pub const CLEAR_MARGIN_K: f64 = 1.0;
@@ -500,7 +527,7 @@ impl CloudField {
         };
         // High (cold, deep) cloud edges are softer than low ones: the width grows with
         // ΔT (thin cirrus fringes of anvils and fronts).
-        let depth = dt / MIN_CLOUD_COLD_K;
+        let depth = dt.min(EDGE_WIDTH_FULL_DEPTH_K) / MIN_CLOUD_COLD_K;
         let width = EDGE_WIDTH_SIGMA * self.sigma * depth * depth * depth.sqrt();
         let deep = smoothstep(
             (dt - DEEP_CONVECTION_ONSET_K) / (DEEP_CONVECTION_FULL_K - DEEP_CONVECTION_ONSET_K),
@@ -892,7 +919,16 @@ impl CloudField {
         // Deep convection: flat anvil tops (depth 1) instead of the deepening core.
         let depth = EDGE_DEPTH_SHARE + 2.0 * (1.0 - EDGE_DEPTH_SHARE) * core;
         let depth = depth + (1.0 - depth) * p.deep;
-        p.t_clear - (m * (p.dt * depth + p.top_texture)).min(MAX_LOCAL_COLD_K)
+        // Tops deeper than EDGE_WIDTH_FULL_DEPTH_K: the edge steps as a cloud that deep,
+        // the rest of the depth comes inside (cold cores of the convective clusters).
+        let edge_dt = p.dt.min(EDGE_WIDTH_FULL_DEPTH_K);
+        let cold = m * (edge_dt * depth + p.top_texture);
+        let cold = if p.dt > edge_dt {
+            cold + smoothstep(x / (DEEP_CORE_WIDTHS * p.width)) * (p.dt - edge_dt)
+        } else {
+            cold
+        };
+        p.t_clear - cold.min(MAX_LOCAL_COLD_K)
     }
 
     /// The point at fractions (u lat, v lon) of `cell`.
@@ -975,6 +1011,19 @@ impl CloudField {
             }
         }
         s * t
+    }
+
+    /// The balance of 1° cell (`row` 0…179 from the south pole, `col` 0…359 from
+    /// longitude 0; clamped / wrapped): its final cloud-threshold shift δ in noise σ
+    /// (bounded by ±[`MAX_THRESHOLD_SHIFT_SIGMA`]) and its final scale s (dimensionless,
+    /// the factor on the temperature that δ could not balance). Builds the cell (and
+    /// what it needs of its neighbours) if not built yet. For diagnostics and tests.
+    pub fn cell_balance(&self, row: usize, col: usize) -> (f64, f64) {
+        let (row, col) = (row.min(OlrGrid::ROWS - 1), col % OlrGrid::COLS);
+        (
+            self.balance(row, col).shift / self.sigma,
+            self.final_scale(row, col),
+        )
     }
 
     /// [`CloudField::temperature_k`] (kept for callers that name the point this way).
