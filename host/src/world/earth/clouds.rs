@@ -996,18 +996,23 @@ impl CloudField {
             return own_s * t;
         }
         let (wy, wx) = (blend_weights(u, b), blend_weights(v, b));
-        let mut s = 0.0;
-        for (dr, wyr) in wy.iter().enumerate() {
-            for (dc, wxc) in wx.iter().enumerate() {
-                let w = wyr * wxc;
-                if w != 0.0 {
-                    let (r, c) = Self::neighbour(row, col, dr, dc);
-                    s += w * if dr == 1 && dc == 1 {
-                        own_s
-                    } else {
-                        self.final_scale(r, c)
-                    };
-                }
+        // At most one neighbour row and one neighbour column have a weight (the band
+        // is narrower than half a cell): the own s, the side neighbours' and the
+        // corner's, each read only where its weight is not 0.
+        let (dr, ay) = if wy[0] > 0.0 { (0, wy[0]) } else { (2, wy[2]) };
+        let (dc, ax) = if wx[0] > 0.0 { (0, wx[0]) } else { (2, wx[2]) };
+        let at = |dr: usize, dc: usize| {
+            let (r, c) = Self::neighbour(row, col, dr, dc);
+            self.final_scale(r, c)
+        };
+        let mut s = wy[1] * wx[1] * own_s;
+        if ax > 0.0 {
+            s += wy[1] * ax * at(1, dc);
+        }
+        if ay > 0.0 {
+            s += ay * wx[1] * at(dr, 1);
+            if ax > 0.0 {
+                s += ay * ax * at(dr, dc);
             }
         }
         s * t
