@@ -75,14 +75,85 @@ fn no_seams_at_cell_borders() {
     assert!(b < 2.0 * i + 0.1, "border steps {b} K vs interior {i} K");
 }
 
+/// No seams in deep-convective decks either: along every 1° border with a cell below
+/// 150 W m⁻² on either side (the warm pool of field (1, 1): 0–10° N, 130–160° E), the
+/// coherent step across the border (the signed mean over 40 points along the border of
+/// T(+0.03°) − T(−0.03°)) is no larger than across lines inside the cells (0.3, 0.5 and
+/// 0.7 of a cell): 90th percentile within 1.25 × the interior's and maximum within the
+/// interior's maximum. Session 24: fails on the field before (borders p90 5.93 K and
+/// max 10.0 K against 2.40 K and 9.15 K inside: cells whose threshold shift saturated
+/// took 3–7 % off their temperature by the scale s, blended over only 0.05°, so they
+/// showed as 1° blocks in rendered frames), passes after (1.74 K and 3.11 K against
+/// 2.64 K and 11.93 K).
+#[test]
+fn no_seams_at_deep_convective_cell_borders() {
+    let f = field(1, 1);
+    let (h, n) = (0.03, 40);
+    let step = |lat: f64, lon: f64, along_lat: bool| -> f64 {
+        let mut s = 0.0;
+        for k in 0..n {
+            let t = (f64::from(k) + 0.5) / f64::from(n);
+            s += if along_lat {
+                f.temperature_k(lat + t, lon + h) - f.temperature_k(lat + t, lon - h)
+            } else {
+                f.temperature_k(lat + h, lon + t) - f.temperature_k(lat - h, lon + t)
+            };
+        }
+        (s / f64::from(n)).abs()
+    };
+    let (mut border, mut interior) = (Vec::new(), Vec::new());
+    for row in 90..100usize {
+        for col in 130..160usize {
+            let (lat, lon) = (row as f64 - 90.0, col as f64);
+            // West border (a line of constant longitude), then south border.
+            for (along_lat, other) in [(true, (row, col - 1)), (false, (row - 1, col))] {
+                let flux = f
+                    .cell_flux_w_m2(row, col)
+                    .min(f.cell_flux_w_m2(other.0, other.1));
+                if flux > 150.0 {
+                    continue;
+                }
+                border.push(step(lat, lon, along_lat));
+                for off in [0.3, 0.5, 0.7] {
+                    interior.push(if along_lat {
+                        step(lat, lon + off, true)
+                    } else {
+                        step(lat + off, lon, false)
+                    });
+                }
+            }
+        }
+    }
+    assert!(border.len() >= 20, "only {} deep borders", border.len());
+    border.sort_by(f64::total_cmp);
+    interior.sort_by(f64::total_cmp);
+    let p90 = |v: &[f64]| v[(v.len() - 1) * 9 / 10];
+    let (bp, ip) = (p90(&border), p90(&interior));
+    let (bm, im) = (border[border.len() - 1], interior[interior.len() - 1]);
+    eprintln!(
+        "{} deep borders: coherent step p90 {bp:.2} K, max {bm:.2} K; interior lines p90 {ip:.2} K, max {im:.2} K",
+        border.len()
+    );
+    assert!(bp <= 1.25 * ip, "border p90 {bp} K vs interior {ip} K");
+    assert!(bm <= im, "border max {bm} K vs interior {im} K");
+}
+
 #[test]
 fn same_inputs_same_bits_other_seed_or_day_other_clouds() {
     let (a, b) = (field(7, 3), field(7, 3));
     let (other_seed, other_day) = (field(8, 3), field(7, 4));
     let mut diff_seed = 0;
     let mut diff_day = 0;
+    // 400 points: 20 in each of 20 cells spread over the globe (−60…54° N, every
+    // 13.7 × 20° E). Each lazily built cell needs its 7 × 7 neighbourhood, so 400
+    // points in 400 different cells cost 20 times the set-up for the same check
+    // (session 24: this test took most of the file's 269 s in a debug build).
     for k in 0..400 {
-        let (lat, lon) = (-60.0 + 0.3 * k as f64, 13.7 * k as f64);
+        let (cell, point) = (k / 20, k % 20);
+        let (lat, lon) = (
+            -60.0 + 6.0 * cell as f64 + 0.047 * point as f64,
+            274.0 * cell as f64 + 0.043 * (point * 7 % 20) as f64,
+        );
         let t = a.temperature_at_k(lat, lon);
         assert_eq!(t.to_bits(), b.temperature_at_k(lat, lon).to_bits());
         diff_seed += usize::from((t - other_seed.temperature_at_k(lat, lon)).abs() > 0.5);
@@ -134,9 +205,11 @@ fn stats_tool_reproduces_the_real_image_readme() {
 /// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K, over 8 patches
 /// (2 days × 4 places, 256 × 256 px), ranges unchanged: 2-px step p99 in 9–17 K for
 /// every patch; share of steps > 10 K in 0.8–3.5 % for the median and at least 7 of 8
-/// patches (measured 2.1–3.6 %: one convective patch at 3.63 %); spectral slope
-/// (8–200 km) in −2.5…−3.3 for the median and at least 3 of 8 patches (measured: mild
-/// patches −2.25…−2.53, deep-convective −3.31…−3.49).
+/// patches; spectral slope (8–200 km) in −2.5…−3.3 for the median and at least 7 of 8
+/// patches (session 23, with the deep-convective regime and its cloud-top texture:
+/// p99 10–14.5 K, share 0.77–3.24 %, slope −2.44…−3.15; the two misses are mild
+/// patches at the ranges' edges: share 0.77 % at (20°, 202°) and slope −2.44 at
+/// (45°, 330°) on day 0).
 #[test]
 fn texture_statistics_within_the_acceptance_ranges() {
     let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
@@ -181,7 +254,7 @@ fn texture_statistics_within_the_acceptance_ranges() {
     eprintln!("median slope {k:.2}, {slopes_in} of 8 patches in range");
     assert!((-3.3..=-2.5).contains(&k), "median slope {k}");
     assert!(
-        slopes_in >= 3,
+        slopes_in >= 7,
         "{slopes_in} patches with the slope in range"
     );
 }

@@ -23,7 +23,7 @@ pub const LUT_OCTAVES: usize = 11;
 pub const LUT_INTERVALS: usize = LUT_NODES_PER_OCTAVE * LUT_OCTAVES;
 
 /// One interval [T_i, T_i+1] of the table: everything the interpolation needs, in f32.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Interval {
     /// T_i, K.
     t_k: f32,
@@ -46,7 +46,7 @@ struct Interval {
 
 /// The fast band-radiance table for one response: 352 intervals, 11 264 bytes
 /// (`size_of::<BandLut>()`), built from the exact f64 path.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct BandLut {
     intervals: [Interval; LUT_INTERVALS],
 }

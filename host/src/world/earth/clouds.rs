@@ -12,7 +12,7 @@
 //!   between cell centres, so no parameter jumps at cell borders): the share of clear
 //!   flux that is missing, r = 1 − F̃/F_clear, sets the cloud fraction
 //!   c = min(√(r / [`OVERCAST_DEFICIT`]), [`MAX_CLOUD_FRACTION`]) and a mean
-//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 15.5…40 K colder than
+//!   cloud-top flux F_clear − r·F_clear/c, i.e. a cloud top ΔT = 15.5…75 K colder than
 //!   the clear surface;
 //! - m = a steep smoothstep of (n − θ): n is a fractal field (value noise on the 3-D
 //!   unit sphere × Earth radius, so there is no seam and no pole singularity; octaves
@@ -22,12 +22,20 @@
 //!   [`EDGE_WIDTH_SIGMA`] gives 1–3 px cloud edges at 4 km per pixel;
 //! - ΔT_local grows from 0.65 ΔT at a cloud's edge to 1.35 ΔT in its core; the edge
 //!   width grows with ΔT (cold high-cloud fringes are softer than low-cloud edges);
+//! - deep convection (ΔT above [`DEEP_CONVECTION_ONSET_K`]): the coarse octaves weigh
+//!   [`DEEP_COARSE_WEIGHT`] and the [`MESOSCALE_OCTAVES`] take their variance, the edge
+//!   width grows with them, the tops are flat and carry their own texture
+//!   ([`CLOUD_TOP_TEXTURE_K`] per σ of the finer octaves): clusters and anvils instead of
+//!   one deck hundreds of km wide; beyond [`EDGE_WIDTH_FULL_DEPTH_K`] a deck's edge
+//!   steps as a 40 K cloud and the rest of its depth comes inside it (cold cores,
+//!   [`DEEP_CORE_WIDTHS`] edge widths in);
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
 //!   (more or less cloud where the noise realisation has too little or too much); s
 //!   scales the whole temperature only for the rest δ cannot reach (within
-//!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`BORDER_BLEND_DEG`] of a cell border δ
-//!   and s blend with the neighbour's (smoothstep), so the field is continuous. Three
+//!   ±[`MAX_THRESHOLD_SHIFT_SIGMA`] σ). Within [`SHIFT_BLEND_DEG`] (δ) and
+//!   [`BORDER_BLEND_DEG`] (s) of a cell border they blend with the neighbour's
+//!   (smoothstep), so the field is continuous. Three
 //!   passes, each lazy per cell: δ of the cell alone; δ again with the neighbours'
 //!   first δ blended in; s from the mean with every final δ blended as rendered.
 //!
@@ -37,9 +45,10 @@
 //! are computed once (thread-safe; the values do not depend on which thread or which
 //! order): the tile holds the temperature before s on 1/[`TILE_NODES_PER_DEG`]° nodes
 //! (both borders included, so neighbouring tiles agree on their shared border), and s
-//! is measured on the tile's bilinear interpolant, which is what
-//! [`CloudField::temperature_k`] returns (times s): the rendered field itself keeps
-//! each cell's flux. [`CloudField::fill`] builds every cell up front (the dataset
+//! is the exact mean over the tile's bilinear interpolant (Gauss–Legendre), which is
+//! what [`CloudField::temperature_k`] returns (times s), with the neighbours' s blended
+//! in along the borders as rendered (`build_final_scale`): the rendered field itself
+//! keeps each cell's flux. [`CloudField::fill`] builds every cell up front (the dataset
 //! library does, once per day and seed); otherwise cells are built on first use.
 
 use std::sync::OnceLock;
@@ -85,25 +94,74 @@ pub const OVERCAST_DEFICIT: f64 = 0.3;
 pub const MAX_CLOUD_FRACTION: f64 = 0.95;
 /// Cloud tops are at least this much colder than the clear surface, K.
 pub const MIN_CLOUD_COLD_K: f64 = 15.5;
-/// ... and at most this much, K (deeper flux deficits come as more cloud, not colder).
-pub const MAX_CLOUD_COLD_K: f64 = 40.0;
-/// Cap of the texture's local depth ΔT_local, K (the coldest convective cores: lets the
-/// threshold shift balance the deepest cells without the scale s).
-pub const MAX_LOCAL_COLD_K: f64 = 48.0;
+/// ... and at most this much, K: deep-convective tops of 195–210 K over the Eq. 10
+/// clear sky of the tropics (~268 K), so that the deepest 1° cells of the built-in field
+/// (~100 W m⁻² at a cloud fraction of 0.95) are reached by the cloud partition itself.
+/// (Session 24: was 40 K; cells below ~150 W m⁻² then saturated their threshold shift
+/// at −[`MAX_THRESHOLD_SHIFT_SIGMA`] and the scale s took 3–7 % off the whole cell,
+/// blended with the neighbours' over only [`BORDER_BLEND_DEG`]: 1°-cell blocks with
+/// straight edges, 6–14 K steps along the borders.)
+pub const MAX_CLOUD_COLD_K: f64 = 75.0;
+/// Cap of the texture's local depth ΔT_local, K (the coldest convective cores with their
+/// top texture; the 80 K upper bound on cloud-top depth).
+pub const MAX_LOCAL_COLD_K: f64 = 80.0;
+/// Cloud depth ΔT beyond which the edge width stops growing and the edge stops
+/// deepening, K (the full deep-convective regime, [`DEEP_CONVECTION_FULL_K`]): growing
+/// on as ΔT^[`EDGE_WIDTH_DEPTH_EXPONENT`], the edges of the deepest decks would spread
+/// over several noise σ and the cloud field would fade into a uniform blend; stepping
+/// by the full ΔT, they would put too many 2-px steps above 10 K.
+pub const EDGE_WIDTH_FULL_DEPTH_K: f64 = 40.0;
+/// The depth a cloud top has beyond [`EDGE_WIDTH_FULL_DEPTH_K`] is reached this many
+/// edge widths inside the cloud (smoothstep): the deepest decks step at their edges as
+/// a 40 K cloud and get colder towards their cores (the coldest tops of convective
+/// clusters sit inside their anvils), so the 2-px steps at deck edges stay within the
+/// real convective scene's range.
+pub const DEEP_CORE_WIDTHS: f64 = 3.0;
 /// Peak-to-peak amplitude of the clear-sky grain (unresolved trade cumulus, surface
 /// and humidity texture), K.
 pub const CLEAR_GRAIN_K: f64 = 2.0;
-/// Half-width of the band along each cell border where (δ, s) blend with the
-/// neighbour cell's, degrees (0.05° ≈ 5.6 km of latitude: about 3 px at 4 km).
-pub const BORDER_BLEND_DEG: f64 = 0.05;
+/// Half-width of the band along each cell border where the scale s blends with the
+/// neighbour cell's, in cell fractions (0.15° ≈ 17 km of latitude: about 4 px at 4 km
+/// on each side). Session 24: was 0.05°; the deepest cells' s still differs from the
+/// neighbours' by up to ~1.7 % (their threshold shift at its bound), a ~3.5 K step at
+/// 210 K, which over 0.1° drew straight lines along the borders; over 0.3° it is a
+/// gradient of about 0.5 K per pixel, under the cloud texture's.
+pub const BORDER_BLEND_DEG: f64 = 0.15;
 /// Half-width of the band along each cell border where the cloud threshold shift
 /// blends with the neighbour's, degrees (0.35°: the threshold changes smoothly over
 /// 80 km, so no cloud is cut along a cell border).
 pub const SHIFT_BLEND_DEG: f64 = 0.35;
+/// Cloud depth ΔT from which a cloud deck counts as deep convection, K: from here its
+/// noise loses large-scale power and its tops flatten (fully at
+/// [`DEEP_CONVECTION_FULL_K`]; smoothstep in between). Deep decks built from the same
+/// octaves as low clouds are single blobs hundreds of km wide, whose 2-D spectrum is
+/// steeper (−3.4…−3.7 over 8–200 km) than real convective scenes (−3.1).
+pub const DEEP_CONVECTION_ONSET_K: f64 = 25.0;
+/// Cloud depth ΔT at which the deep-convective regime is full, K (deeper tops, up to
+/// [`MAX_CLOUD_COLD_K`], keep the full regime).
+pub const DEEP_CONVECTION_FULL_K: f64 = 40.0;
+/// Weight of the coarse (≥ 100 km) octaves in a full deep-convective regime: deep
+/// convection comes as clusters of 20–100 km cells and anvils, not as one deck.
+pub const DEEP_COARSE_WEIGHT: f64 = 0.3;
+/// The mesoscale octaves (indices into [`OCTAVE_LATTICE_KM`]: 50 and 25 km) that take
+/// the coarse octaves' lost variance in the deep-convective regime, so the noise's
+/// variance (and so the cloud fraction of a threshold) is kept. The finer octaves
+/// (12 and 6 km) keep their amplitude: amplifying them puts power below the tile's
+/// 3.5 km node spacing.
+pub const MESOSCALE_OCTAVES: std::ops::Range<usize> = 3..6;
+/// Amplitude of a deep-convective cloud top's own texture per σ of the finer (12 and
+/// 6 km) octaves, K: it restores the small-scale power that soft deep-cloud edges lack
+/// (real convective scenes: spectrum slope −3.1; without it −3.4…−3.8 here), while the
+/// 2-px steps stay within the real scenes' range (it is a few K, not an edge).
+pub const CLOUD_TOP_TEXTURE_K: f64 = 3.0;
+/// The cloud-top texture's noise is clipped at this many σ (so it stays a few K).
+pub const CLOUD_TOP_TEXTURE_CLIP: f64 = 2.0;
 /// Sample points per axis of a cell's energy balance (16 × 16, cell-centred).
 pub const BALANCE_SAMPLES: usize = 16;
-/// Largest shift of a cell's cloud threshold its balance may use, noise σ.
-pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 6.0;
+/// Largest shift of a cell's cloud threshold its balance may use, noise σ (session 24:
+/// was 6; the deepest cells need their cores, [`DEEP_CORE_WIDTHS`] edge widths inside
+/// the clouds, over most of their area).
+pub const MAX_THRESHOLD_SHIFT_SIGMA: f64 = 12.0;
 /// Margin of the local clear sky above the Eq. 10 temperature of the interpolated flux,
 /// K: where a cell is warmer than the clear-sky climatology its clear sky warms with it.
 pub const CLEAR_MARGIN_K: f64 = 1.0;
@@ -113,6 +171,9 @@ const SOLVE_STEPS: usize = 40;
 /// Relative flux error at which a threshold shift is taken (10⁻⁴: far below the
 /// 0.5 % the cells keep; s removes it).
 const SOLVE_TOLERANCE: f64 = 1e-4;
+/// Newton steps of a cell's final scale (the quartic is monotone and near-linear
+/// around the stand-alone s, a few steps reach machine precision).
+const FINAL_SCALE_NEWTON_STEPS: usize = 8;
 /// Tile nodes per degree: 1/32° ≈ 3.5 km, finer than the camera's ~4 km pixel, so the
 /// renderer interpolates bilinearly between nodes at about the pixel scale.
 pub const TILE_NODES_PER_DEG: usize = 32;
@@ -123,8 +184,16 @@ const TILE_OFFSET_K: f64 = 100.0;
 /// Temperature step of a tile's code, K (0.005 K: 100…427 K in 16 bits; the
 /// quantisation is far below the 0.5 K of the real data and is in the balance).
 const TILE_STEP_K: f64 = 0.005;
-/// Sample points per axis of a tile's scale s (2 per node interval, cell-centred).
-const SCALE_SAMPLES: usize = 64;
+/// Gauss–Legendre nodes (on [0, 1]) and weights per tile node interval and axis for a
+/// tile's scale s: 3 points integrate a polynomial of degree ≤ 5 exactly, and σT⁴ of
+/// the bilinear interpolant is of degree 4 along each axis, so s is measured on the
+/// exact mean of what is rendered (up to the cos φ weight's curvature, ~10⁻⁸ over a
+/// 1/32° interval).
+const GAUSS3: [(f64, f64); 3] = [
+    (0.112_701_665_379_258_3, 5.0 / 18.0),
+    (0.5, 8.0 / 18.0),
+    (0.887_298_334_620_741_7, 5.0 / 18.0),
+];
 /// Coarse node grid per cell axis (1/8° spacing, both borders included).
 const NODES: usize = 9;
 /// Lattice table side (values repeat every 32 lattice cells; each octave is rotated and
@@ -180,6 +249,10 @@ struct Point {
     n: f64,
     /// Edge transition width (grows with ΔT), noise units.
     width: f64,
+    /// Weight of the deep-convective regime, 0…1 (from ΔT).
+    deep: f64,
+    /// Cloud-top texture of a deep-convective cloud, K (added to its depth).
+    top_texture: f64,
 }
 
 /// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
@@ -191,11 +264,19 @@ pub struct CloudField {
     octaves: Vec<Octave>,
     quantiles: [f64; QUANTILES + 1],
     sigma: f64,
+    /// Standard deviation of the octaves finer than the mesoscale ones (σ × their
+    /// share of the variance, square-rooted).
+    small_sigma: f64,
+    /// Σ a² of the coarse octaves over that of the mesoscale ones.
+    coarse_over_meso_var: f64,
     clear_t_k: Vec<f64>,
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
     tiles: Vec<OnceLock<Box<Tile>>>,
-    /// Every cell's scale s in one flat array, row-major, once [`CloudField::fill`] has
+    /// Every cell's final scale s (with the border blend, see
+    /// [`CloudField::build_final_scale`]), built on use.
+    final_scales: Vec<OnceLock<f64>>,
+    /// Every cell's final scale s in one flat array, row-major, once [`CloudField::fill`] has
     /// built them all: the border blend reads up to four neighbours' s per ray, and
     /// this spares it the pointer chase into each neighbour's tile.
     scales: OnceLock<Vec<f64>>,
@@ -209,10 +290,13 @@ impl Clone for CloudField {
             octaves: self.octaves.clone(),
             quantiles: self.quantiles,
             sigma: self.sigma,
+            small_sigma: self.small_sigma,
+            coarse_over_meso_var: self.coarse_over_meso_var,
             clear_t_k: self.clear_t_k.clone(),
             cells: self.cells.clone(),
             balance: self.balance.clone(),
             tiles: self.tiles.clone(),
+            final_scales: self.final_scales.clone(),
             scales: self.scales.clone(),
         }
     }
@@ -307,6 +391,8 @@ impl CloudField {
             octaves,
             quantiles: [0.0; QUANTILES + 1],
             sigma: 1.0,
+            small_sigma: 1.0,
+            coarse_over_meso_var: 1.0,
             clear_t_k,
             cells: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
@@ -315,6 +401,9 @@ impl CloudField {
                 .map(|_| OnceLock::new())
                 .collect(),
             tiles: (0..OlrGrid::ROWS * OlrGrid::COLS)
+                .map(|_| OnceLock::new())
+                .collect(),
+            final_scales: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
                 .collect(),
             scales: OnceLock::new(),
@@ -334,6 +423,11 @@ impl CloudField {
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / values.len() as f64;
         field.sigma = var.sqrt();
+        let all = Self::octave_var(&field.octaves, 0..field.octaves.len());
+        let small = Self::octave_var(&field.octaves, MESOSCALE_OCTAVES.end..field.octaves.len());
+        field.small_sigma = field.sigma * (small / all).sqrt();
+        field.coarse_over_meso_var = Self::octave_var(&field.octaves, 0..COARSE_OCTAVES)
+            / Self::octave_var(&field.octaves, MESOSCALE_OCTAVES);
         for (q, slot) in field.quantiles.iter_mut().enumerate() {
             let idx = (q * (values.len() - 1)) / QUANTILES;
             *slot = values[idx];
@@ -411,7 +505,10 @@ impl CloudField {
 
     /// What a point needs before its cell's threshold shift: (clear temperature with
     /// grain, K; cloud depth ΔT, K; base threshold θ; noise n).
-    fn point(&self, lat_deg: f64, lon_deg: f64, n: f64, n_fine: f64) -> Point {
+    /// `n` holds the noise's (coarse, mesoscale, finer) parts; they are weighted by the
+    /// deep-convective regime of the point's ΔT.
+    fn point(&self, lat_deg: f64, lon_deg: f64, n: [f64; 3], n_fine: f64) -> Point {
+        let n_small = n[2];
         let f = self.flux_at(lat_deg, lon_deg);
         let t_clear = self
             .clear_t(lat_deg)
@@ -430,14 +527,32 @@ impl CloudField {
         };
         // High (cold, deep) cloud edges are softer than low ones: the width grows with
         // ΔT (thin cirrus fringes of anvils and fronts).
-        let depth = dt / MIN_CLOUD_COLD_K;
+        let depth = dt.min(EDGE_WIDTH_FULL_DEPTH_K) / MIN_CLOUD_COLD_K;
         let width = EDGE_WIDTH_SIGMA * self.sigma * depth * depth * depth.sqrt();
+        let deep = smoothstep(
+            (dt - DEEP_CONVECTION_ONSET_K) / (DEEP_CONVECTION_FULL_K - DEEP_CONVECTION_ONSET_K),
+        );
+        // The mesoscale gain g steepens the noise's gradient about g times: the edge
+        // width (in noise units) grows with it, so the edges keep their width in km.
+        let (n, width) = if deep > 0.0 {
+            let (wc, gm) = self.deep_weights(deep);
+            (wc * n[0] + gm * n[1] + n[2], width * gm)
+        } else {
+            (n[0] + n[1] + n[2], width)
+        };
+        // Deep cloud tops are not flat at the camera's scale (overshooting tops, gravity
+        // waves, anvil cirrus): the finer octaves, in their own σ, give them texture.
+        let top_texture = deep
+            * CLOUD_TOP_TEXTURE_K
+            * (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
         Point {
             t_clear: t_clear + grain,
             dt,
             theta,
             n,
             width,
+            deep,
+            top_texture,
         }
     }
 
@@ -453,9 +568,91 @@ impl CloudField {
         self.tiles[row * OlrGrid::COLS + col].get_or_init(|| Box::new(self.build_tile(row, col)))
     }
 
+    /// The cell's final scale s (from the flat array once [`CloudField::fill`] ran).
+    #[inline]
+    fn final_scale(&self, row: usize, col: usize) -> f64 {
+        let i = row * OlrGrid::COLS + col;
+        match self.scales.get() {
+            Some(scales) => scales[i],
+            None => *self.final_scales[i].get_or_init(|| self.build_final_scale(row, col)),
+        }
+    }
+
+    /// The cell's final scale s: what is rendered within [`BORDER_BLEND_DEG`] of a border
+    /// is the tile times the blend of the own s with the neighbours', so a stand-alone s
+    /// (the tile's) misses the flux by up to ~0.7 % where neighbours' s differ. With
+    /// the neighbours' stand-alone s in the blend, the own s solves
+    /// mean((w·s + b)⁴·σt⁴) = F exactly on the tile's interpolant (the [`GAUSS3`]
+    /// points; w the own blend weight, b the neighbours' blended s; a quartic in s,
+    /// Newton from the stand-alone s). Left: the neighbours' own change from their
+    /// stand-alone s, second order in the blend band's share of the cell.
+    fn build_final_scale(&self, row: usize, col: usize) -> f64 {
+        let tile = self.tile(row, col);
+        let mut nb = [[0.0f64; 3]; 3];
+        for (dr, line) in nb.iter_mut().enumerate() {
+            for (dc, v) in line.iter_mut().enumerate() {
+                if dr != 1 || dc != 1 {
+                    let (r, c) = Self::neighbour(row, col, dr, dc);
+                    *v = self.tile(r, c).s;
+                }
+            }
+        }
+        let last = (TILE_NODES - 1) as f64;
+        let lat0 = row as f64 - 90.0;
+        // (fraction, Gauss weight, blend weights) of every Gauss point along an axis.
+        let gauss: Vec<(f64, f64, [f64; 3])> = (0..TILE_NODES - 1)
+            .flat_map(|k| {
+                GAUSS3.map(|(x, w)| {
+                    let u = (k as f64 + x) / last;
+                    (u, w, blend_weights(u, BORDER_BLEND_DEG))
+                })
+            })
+            .collect();
+        // Moments m_k = Σ weight · C(4, k)·w^k·b^(4−k)·σt⁴: flux(s) = Σ m_k s^k / Σ weight.
+        let mut m = [0.0f64; 5];
+        let mut wsum = 0.0;
+        for &(u, wu, wy) in &gauss {
+            let wl = wu * libm::cos((lat0 + u).to_radians());
+            for &(v, wv, wx) in &gauss {
+                let t = tile.interpolate(u, v);
+                let q = wl * wv * STEFAN_BOLTZMANN_W_M2_K4 * (t * t) * (t * t);
+                wsum += wl * wv;
+                if wy[1] == 1.0 && wx[1] == 1.0 {
+                    // Away from the borders only the own s counts.
+                    m[4] += q;
+                    continue;
+                }
+                let mut b = 0.0;
+                for (dr, wyr) in wy.iter().enumerate() {
+                    for (dc, wxc) in wx.iter().enumerate() {
+                        b += wyr * wxc * nb[dr][dc];
+                    }
+                }
+                let own = wy[1] * wx[1];
+                let (o2, b2) = (own * own, b * b);
+                m[0] += q * b2 * b2;
+                m[1] += q * 4.0 * own * b2 * b;
+                m[2] += q * 6.0 * o2 * b2;
+                m[3] += q * 4.0 * o2 * own * b;
+                m[4] += q * o2 * o2;
+            }
+        }
+        let target = f64::from(self.flux[row * OlrGrid::COLS + col]) * wsum;
+        let mut x = tile.s;
+        for _ in 0..FINAL_SCALE_NEWTON_STEPS {
+            let f = m[0] + x * (m[1] + x * (m[2] + x * (m[3] + x * m[4])));
+            let df = m[1] + x * (2.0 * m[2] + x * (3.0 * m[3] + x * 4.0 * m[4]));
+            if df <= 0.0 {
+                break;
+            }
+            x -= (f - target) / df;
+        }
+        if x.is_finite() && x > 0.0 { x } else { tile.s }
+    }
+
     /// The cell's rendered tile: every node's temperature with the final shifts
     /// blended as in the module docs, then s from the mean σT⁴ of the bilinear
-    /// interpolant the renderer reads (measured on [`SCALE_SAMPLES`]² cell-centred
+    /// interpolant the renderer reads (its exact mean: [`GAUSS3`] points per node interval,
     /// points, cos φ weighted), so the cell keeps its flux in what is rendered.
     fn build_tile(&self, row: usize, col: usize) -> Tile {
         let cell = self.cell(row, col);
@@ -497,16 +694,21 @@ impl CloudField {
             }
         }
         let mut tile = Tile { t, s: 1.0 };
+        // The exact cos φ-weighted mean of σT⁴ over the interpolant: 3 × 3 Gauss points
+        // in every node interval (the interpolant is bilinear there).
         let (mut sum, mut wsum) = (0.0, 0.0);
-        for i in 0..SCALE_SAMPLES {
-            let u = (i as f64 + 0.5) / SCALE_SAMPLES as f64;
-            let w = libm::cos((lat0 + u).to_radians());
-            for j in 0..SCALE_SAMPLES {
-                let v = (j as f64 + 0.5) / SCALE_SAMPLES as f64;
+        let gauss: Vec<(f64, f64)> = (0..TILE_NODES - 1)
+            .flat_map(|k| GAUSS3.map(|(x, w)| ((k as f64 + x) / last, w)))
+            .collect();
+        for &(u, wu) in &gauss {
+            let w = wu * libm::cos((lat0 + u).to_radians());
+            let mut line = 0.0;
+            for &(v, wv) in &gauss {
                 let t = tile.interpolate(u, v);
-                sum += w * STEFAN_BOLTZMANN_W_M2_K4 * (t * t) * (t * t);
-                wsum += w;
+                line += wv * (t * t) * (t * t);
             }
+            sum += w * STEFAN_BOLTZMANN_W_M2_K4 * line;
+            wsum += w * (TILE_NODES - 1) as f64;
         }
         let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
         if sum > 0.0 {
@@ -519,7 +721,9 @@ impl CloudField {
     /// renderer then only reads. The values are those a lazy build gives (each is a
     /// function of the cell alone), so the result does not depend on the thread count.
     /// Costs about 28 s of CPU for the 64 800 cells in a release build (~0.43 ms per
-    /// cell: two threshold solves on 16 × 16 points and 33 × 33 tile nodes), and holds
+    /// cell: two threshold solves on 16 × 16 points and 33 × 33 tile nodes; measured
+    /// before session 23's Gauss-exact, border-aware scale s, which adds two passes of
+    /// 96 × 96 interpolant points per cell), and holds
     /// about 165 MB ([`CloudField::memory_bytes`]: 2.2 kB of tile and 0.3 kB of coarse
     /// noise per cell).
     pub fn fill(&self) {
@@ -538,14 +742,14 @@ impl CloudField {
             let (r, c) = split(i);
             self.tile(r, c);
         });
-        self.scales.get_or_init(|| {
-            (0..n)
-                .map(|i| {
-                    let (r, c) = split(i);
-                    self.tile(r, c).s
-                })
-                .collect()
-        });
+        let scales = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let (r, c) = split(i);
+                self.final_scale(r, c)
+            })
+            .collect();
+        self.scales.get_or_init(|| scales);
     }
 
     /// Heap memory held by the built cells and tiles, bytes.
@@ -712,8 +916,19 @@ impl CloudField {
         let m = smoothstep(x / p.width + 0.5);
         // Deeper (colder) towards a cloud's core: 0.65 ΔT at the edge, 1.35 ΔT well inside.
         let core = smoothstep(x / (1.2 * self.sigma));
+        // Deep convection: flat anvil tops (depth 1) instead of the deepening core.
         let depth = EDGE_DEPTH_SHARE + 2.0 * (1.0 - EDGE_DEPTH_SHARE) * core;
-        p.t_clear - (m * p.dt * depth).min(MAX_LOCAL_COLD_K)
+        let depth = depth + (1.0 - depth) * p.deep;
+        // Tops deeper than EDGE_WIDTH_FULL_DEPTH_K: the edge steps as a cloud that deep,
+        // the rest of the depth comes inside (cold cores of the convective clusters).
+        let edge_dt = p.dt.min(EDGE_WIDTH_FULL_DEPTH_K);
+        let cold = m * (edge_dt * depth + p.top_texture);
+        let cold = if p.dt > edge_dt {
+            cold + smoothstep(x / (DEEP_CORE_WIDTHS * p.width)) * (p.dt - edge_dt)
+        } else {
+            cold
+        };
+        p.t_clear - cold.min(MAX_LOCAL_COLD_K)
     }
 
     /// The point at fractions (u lat, v lon) of `cell`.
@@ -727,9 +942,30 @@ impl CloudField {
         let b = at(i + 1, j) + (at(i + 1, j + 1) - at(i + 1, j)) * tx;
         let coarse = a + (b - a) * ty;
         let last = self.octaves.len();
-        let mid = self.noise(p, COARSE_OCTAVES..last - 1);
+        let meso = self.noise(p, MESOSCALE_OCTAVES);
+        let small = self.noise(p, MESOSCALE_OCTAVES.end..last - 1);
         let fine = self.noise(p, last - 1..last);
-        self.point(lat, lon, coarse + mid + fine, fine)
+        self.point(lat, lon, [coarse, meso, small + fine], fine)
+    }
+
+    /// Weights of the (coarse, mesoscale) noise in a deep-convective regime of weight
+    /// `deep` ∈ [0, 1]: the coarse octaves × (1 − (1 − [`DEEP_COARSE_WEIGHT`])·deep),
+    /// the mesoscale ones × g with g² = 1 + (1 − w_c²)·Σ_coarse a² / Σ_meso a², so the
+    /// variance of the sum is kept (the octaves are independent, each of variance ∝ its
+    /// amplitude a²).
+    fn deep_weights(&self, deep: f64) -> (f64, f64) {
+        let wc = 1.0 - (1.0 - DEEP_COARSE_WEIGHT) * deep;
+        let gm = (1.0 + (1.0 - wc * wc) * self.coarse_over_meso_var).sqrt();
+        (wc, gm)
+    }
+
+    /// Σ a² over the octaves in `range` (the variance of their sum, up to one
+    /// octave's variance).
+    fn octave_var(octaves: &[Octave], range: std::ops::Range<usize>) -> f64 {
+        octaves[range]
+            .iter()
+            .map(|o| o.amplitude * o.amplitude)
+            .sum()
     }
 
     /// Brightness temperature of the texture at (`lat_deg`, `lon_deg`), K: the
@@ -754,28 +990,45 @@ impl CloudField {
         let (u, v) = (lat + 90.0 - row as f64, lon - col as f64);
         let tile = self.tile(row, col);
         let t = tile.interpolate(u, v);
+        let own_s = self.final_scale(row, col);
         let b = BORDER_BLEND_DEG;
         if u >= b && u <= 1.0 - b && v >= b && v <= 1.0 - b {
-            return tile.s * t;
+            return own_s * t;
         }
         let (wy, wx) = (blend_weights(u, b), blend_weights(v, b));
-        let mut s = 0.0;
-        for (dr, wyr) in wy.iter().enumerate() {
-            for (dc, wxc) in wx.iter().enumerate() {
-                let w = wyr * wxc;
-                if w != 0.0 {
-                    let (r, c) = Self::neighbour(row, col, dr, dc);
-                    s += w * if dr == 1 && dc == 1 {
-                        tile.s
-                    } else if let Some(scales) = self.scales.get() {
-                        scales[r * OlrGrid::COLS + c]
-                    } else {
-                        self.tile(r, c).s
-                    };
-                }
+        // At most one neighbour row and one neighbour column have a weight (the band
+        // is narrower than half a cell): the own s, the side neighbours' and the
+        // corner's, each read only where its weight is not 0.
+        let (dr, ay) = if wy[0] > 0.0 { (0, wy[0]) } else { (2, wy[2]) };
+        let (dc, ax) = if wx[0] > 0.0 { (0, wx[0]) } else { (2, wx[2]) };
+        let at = |dr: usize, dc: usize| {
+            let (r, c) = Self::neighbour(row, col, dr, dc);
+            self.final_scale(r, c)
+        };
+        let mut s = wy[1] * wx[1] * own_s;
+        if ax > 0.0 {
+            s += wy[1] * ax * at(1, dc);
+        }
+        if ay > 0.0 {
+            s += ay * wx[1] * at(dr, 1);
+            if ax > 0.0 {
+                s += ay * ax * at(dr, dc);
             }
         }
         s * t
+    }
+
+    /// The balance of 1° cell (`row` 0…179 from the south pole, `col` 0…359 from
+    /// longitude 0; clamped / wrapped): its final cloud-threshold shift δ in noise σ
+    /// (bounded by ±[`MAX_THRESHOLD_SHIFT_SIGMA`]) and its final scale s (dimensionless,
+    /// the factor on the temperature that δ could not balance). Builds the cell (and
+    /// what it needs of its neighbours) if not built yet. For diagnostics and tests.
+    pub fn cell_balance(&self, row: usize, col: usize) -> (f64, f64) {
+        let (row, col) = (row.min(OlrGrid::ROWS - 1), col % OlrGrid::COLS);
+        (
+            self.balance(row, col).shift / self.sigma,
+            self.final_scale(row, col),
+        )
     }
 
     /// [`CloudField::temperature_k`] (kept for callers that name the point this way).
