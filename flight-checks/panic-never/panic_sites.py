@@ -23,7 +23,9 @@ from collections import defaultdict
 # The repository root: frames in its core/ and firmware/ sources are "ours".
 REPO = os.path.realpath(os.path.join(os.path.dirname(__file__), "..", ".."))
 PANIC_ROOT = "rust_begin_unwind"
-OURS = ("tirroi_core::", "tirroi_firmware::", "tirroi_panic_never::", "<tirroi_core::", "<tirroi_firmware::")
+# `_start` is the check's entry: a component called straight from it (auto-v2) is
+# inlined into it, so its branches are ours too (addr2line's chain names the source).
+OURS = ("tirroi_core::", "tirroi_firmware::", "tirroi_panic_never::", "<tirroi_core::", "<tirroi_firmware::", "_start")
 FUNC_RE = re.compile(r"^([0-9a-f]+) <(.+)>:$")
 BRANCH_RE = re.compile(r"^\s*([0-9a-f]+):\s+(b|bl|b\.w|b\.n|b[a-z]{2}(?:\.[wn])?)\s+([0-9a-f]+) <(.+?)(\+0x[0-9a-f]+)?>")
 

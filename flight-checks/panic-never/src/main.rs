@@ -11,7 +11,8 @@
 //! referenced and the link fails with `undefined symbol: tirroi_panic_path_found`.
 //!
 //! Which components are linked is chosen by cargo features (`otsu`, `adaptive`, `wge`,
-//! `dog`, `auto`, `auto-prior`, `sensor`); `scripts/panic-never.sh` builds the required
+//! `dog`, `auto`, `auto-prior`, `sensor`, and `auto-v2`, the development detector, not
+//! yet required); `scripts/panic-never.sh` builds the required
 //! set, and on a failure or for components not yet required, each one alone, and names
 //! the functions and source lines that still reach a panic.
 //!
@@ -62,6 +63,8 @@ pub extern "C" fn _start() -> ! {
     let mut pixels = [0u16; FRAME_PIXELS];
     let pixels = black_box(&mut pixels);
     let mut detectors = Detectors::new();
+    // Unused when only `auto-v2` (called from the core directly) is checked.
+    #[allow(unused_variables)]
     let detectors = black_box(&mut detectors);
     #[cfg(feature = "otsu")]
     detect(detectors, Method::Otsu, pixels);
@@ -86,6 +89,21 @@ pub extern "C" fn _start() -> ! {
                 black_box(0),
             ));
             let _ = black_box(detectors.track(prior, &frame));
+        }
+    }
+    #[cfg(feature = "auto-v2")]
+    {
+        // The development detector `auto-v2` (issue 16) is not in the firmware's
+        // registry yet: called straight from the core, with its own scratch.
+        use tirroi_core::roi::Detector;
+        use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+        let mut scratch = AutoV2Scratch::new();
+        let width = black_box(FRAME_WIDTH);
+        let height = black_box(FRAME_HEIGHT);
+        let bits = black_box(DEFAULT_BIT_DEPTH);
+        if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, bits) {
+            let detector = black_box(AutoV2::default());
+            let _ = black_box(detector.detect(&frame, black_box(&mut scratch)));
         }
     }
     #[cfg(feature = "sensor")]
