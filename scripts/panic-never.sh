@@ -23,8 +23,8 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 
-REQUIRED=(otsu adaptive wge dog auto auto-prior sensor)
-PENDING=(auto-v2)
+REQUIRED=(otsu adaptive wge dog auto auto-prior sensor auto-v2)
+PENDING=()
 
 if [[ $# -gt 0 ]]; then
     REQUIRED=("$@")

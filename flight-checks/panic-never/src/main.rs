@@ -11,8 +11,8 @@
 //! referenced and the link fails with `undefined symbol: tirroi_panic_path_found`.
 //!
 //! Which components are linked is chosen by cargo features (`otsu`, `adaptive`, `wge`,
-//! `dog`, `auto`, `auto-prior`, `sensor`, and `auto-v2`, the development detector, not
-//! yet required); `scripts/panic-never.sh` builds the required
+//! `dog`, `auto`, `auto-prior`, `sensor`, and `auto-v2`, the development detector, called
+//! from the core directly); `scripts/panic-never.sh` builds the required
 //! set, and on a failure or for components not yet required, each one alone, and names
 //! the functions and source lines that still reach a panic.
 //!

@@ -73,7 +73,12 @@ pub fn fill_cells(
                 *st = best;
             }
         }
-        for (code, &st) in planes.step_code[cy * pw..(cy + 1) * pw]
+        // `get_mut`: the planes hold pw·ph cells (the caller's slices), so the row is
+        // always there; an empty row instead of a panic path if not.
+        for (code, &st) in planes
+            .step_code
+            .get_mut(cy * pw..(cy + 1) * pw)
+            .unwrap_or_default()
             .iter_mut()
             .zip(step_row.iter())
         {
@@ -81,7 +86,10 @@ pub fn fill_cells(
             *code = super::features::log_code(q).clamp(0, 255) as u8;
         }
         let rows = (yb - ya) as u32;
-        for (cx, (m, &s)) in planes.mean_dn[cy * pw..(cy + 1) * pw]
+        for (cx, (m, &s)) in planes
+            .mean_dn
+            .get_mut(cy * pw..(cy + 1) * pw)
+            .unwrap_or_default()
             .iter_mut()
             .zip(sums.iter())
             .enumerate()

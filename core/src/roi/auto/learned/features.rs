@@ -84,26 +84,31 @@ pub fn integrate(
         let (mut rs, mut rq, mut rq2, mut re) = (0u32, 0u32, 0u32, 0u16);
         for cx in 0..pw {
             let i = cy * pw + cx;
-            let m = u32::from(mean_dn[i]);
-            let q = (u32::from(mean_dn[i].saturating_sub(lv.p2)) >> lv.sd_shift).min(SD_Q_MAX);
+            let mean = mean_dn.get(i).copied().unwrap_or(0);
+            let m = u32::from(mean);
+            let q = (u32::from(mean.saturating_sub(lv.p2)) >> lv.sd_shift).min(SD_Q_MAX);
             rs += m;
             rq += q;
             rq2 += q * q;
-            re += u16::from(i32::from(step_code[i]) >= edge_code);
-            let (us, uq, uq2, ue) = if cy > 0 {
-                (
-                    ints.sum[i - pw],
-                    ints.sum_q[i - pw],
-                    ints.sum_sq[i - pw],
-                    ints.edges[i - pw],
-                )
-            } else {
-                (0, 0, 0, 0)
-            };
-            ints.sum[i] = rs + us;
-            ints.sum_q[i] = rq + uq;
-            ints.sum_sq[i] = rq2 + uq2;
-            ints.edges[i] = re + ue;
+            re += u16::from(i32::from(step_code.get(i).copied().unwrap_or(0)) >= edge_code);
+            // The row above (0 on the first row); `get`: the planes hold the pw·ph
+            // cells, so every read and write is in range (no panic path if not).
+            let above = if cy > 0 { i.checked_sub(pw) } else { None };
+            let up = |plane: &[u32]| above.and_then(|j| plane.get(j)).copied().unwrap_or(0);
+            let (us, uq, uq2) = (up(ints.sum), up(ints.sum_q), up(ints.sum_sq));
+            let ue = above.and_then(|j| ints.edges.get(j)).copied().unwrap_or(0);
+            if let Some(v) = ints.sum.get_mut(i) {
+                *v = rs + us;
+            }
+            if let Some(v) = ints.sum_q.get_mut(i) {
+                *v = rq + uq;
+            }
+            if let Some(v) = ints.sum_sq.get_mut(i) {
+                *v = rq2 + uq2;
+            }
+            if let Some(v) = ints.edges.get_mut(i) {
+                *v = re + ue;
+            }
         }
     }
 }
@@ -116,12 +121,14 @@ fn box_sums(
 ) -> (u64, u64, u64, u32) {
     let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
         (Some(x), Some(y)) => {
+            // Corners of a box inside the plane: always in range (`get`: no panic path).
             let i = y * pw + x;
+            let at32 = |plane: &[u32]| u64::from(plane.get(i).copied().unwrap_or(0));
             (
-                u64::from(ints.sum[i]),
-                u64::from(ints.sum_q[i]),
-                u64::from(ints.sum_sq[i]),
-                u32::from(ints.edges[i]),
+                at32(ints.sum),
+                at32(ints.sum_q),
+                at32(ints.sum_sq),
+                u32::from(ints.edges.get(i).copied().unwrap_or(0)),
             )
         }
         _ => (0, 0, 0, 0),
@@ -204,28 +211,31 @@ pub fn cell_features(
     (hot, cold): (u16, u16),
     out: &mut [i32; FEATURES],
 ) {
+    // The cell is inside the plane (`get`: no panic path if not).
     let i = cy * pw + cx;
-    let m = i64::from(mean_dn[i]);
+    let m = i64::from(mean_dn.get(i).copied().unwrap_or(0));
     let s = lv.sigma;
     let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(s));
     out[0] = ((m - i64::from(lv.p50)) * 256 / range).clamp(-4096, 4096) as i32;
     out[1] = slog(m - i64::from(lv.p2), s);
     out[2] = slog(i64::from(lv.p98) - m, s);
-    out[3] = i32::from(step_code[i]);
+    out[3] = i32::from(step_code.get(i).copied().unwrap_or(0));
     out[4] = slog(i64::from(lv.max_dn) - m, s);
     // The 8 neighbours' mean (radius-1 box without the cell) and the 16-px box's σ.
     let (mut reference, mut sd2) = (m, i64::from(s));
     for (k, &r) in RADII_CELLS.iter().enumerate() {
         let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
         let (x1, y1) = ((cx + r).min(pw - 1), (cy + r).min(ph - 1));
-        let n = ((x1 - x0 + 1) * (y1 - y0 + 1)) as u64;
+        // At least 1 cell (x1 ≥ x0, y1 ≥ y0 for any plane of at least one cell); `max`
+        // removes the division's panic path.
+        let n = (((x1 - x0 + 1) * (y1 - y0 + 1)) as u64).max(1);
         let (sum, sum_q, sum_sq, edges) = box_sums(ints, pw, (x0, y0, x1, y1));
         let mean = (sum / n) as i64;
         // Variance of q in 1/n² units: (n Σq² − (Σq)²) / n².
         let var_n2 = (n * sum_sq).saturating_sub(sum_q * sum_q);
         let sd = ((var_n2.isqrt() / n) << lv.sd_shift) as i64;
         if k == 0 && n > 1 {
-            reference = (sum.saturating_sub(m as u64) / (n - 1)) as i64;
+            reference = sum.saturating_sub(m as u64).checked_div(n - 1).unwrap_or(0) as i64;
         }
         if k == 1 {
             sd2 = sd.max(i64::from(s));

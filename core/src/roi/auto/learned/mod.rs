@@ -405,7 +405,11 @@ impl AutoV2 {
             let labels8 = &work.labels8.as_ref()[..n8];
             for (cy, row) in labels4.chunks_exact_mut(plane4.0).enumerate() {
                 for (cx, l) in row.iter_mut().enumerate() {
-                    *l = labels8[(cy / 2) * plane8.0 + cx / 2];
+                    // Every 4×4 cell lies in an 8×8 one (`get`: no panic path).
+                    *l = labels8
+                        .get((cy / 2) * plane8.0 + cx / 2)
+                        .copied()
+                        .unwrap_or_default();
                 }
             }
         }
@@ -436,8 +440,15 @@ impl AutoV2 {
             &gate,
             &region,
             near_sat,
-            &mut work.col_sat.as_mut()[region.rx0..region.rx1],
-            &mut work.row_sat.as_mut()[region.ry0..region.ry1],
+            // The region lies inside the frame (`get_mut`: no panic path if not).
+            work.col_sat
+                .as_mut()
+                .get_mut(region.rx0..region.rx1)
+                .unwrap_or_default(),
+            work.row_sat
+                .as_mut()
+                .get_mut(region.ry0..region.ry1)
+                .unwrap_or_default(),
         );
         let saturated = counts.sat_px >= MIN_SATURATED_PX
             && 8u32.saturating_mul(counts.near_px) < counts.sat_px;
