@@ -18,6 +18,15 @@ fn frame_of(f: impl Fn(usize, usize) -> u16) -> Vec<u16> {
     (0..W * H).map(|i| f(i % W, i / W)).collect()
 }
 
+/// A 105 × 70 px box at 9000 DN on deep space (0 DN): x 120..225, y 80..150.
+fn bright_box_scene(x: usize, y: usize) -> u16 {
+    if (120..225).contains(&x) && (80..150).contains(&y) {
+        9000
+    } else {
+        0
+    }
+}
+
 fn detect(auto: Auto, px: &[u16]) -> Option<Roi> {
     let frame = Frame::reference(px).unwrap();
     let mut s = Box::<AutoScratch>::default();
@@ -53,13 +62,7 @@ fn scratch_fits_32_kib_and_is_static() {
 
 #[test]
 fn bright_box_on_deep_space_is_exact() {
-    let px = frame_of(|x, y| {
-        if (120..225).contains(&x) && (80..150).contains(&y) {
-            9000
-        } else {
-            0
-        }
-    });
+    let px = frame_of(bright_box_scene);
     assert_eq!(
         detect(Auto::default(), &px),
         Some(Roi::new(120, 80, 225, 150))
@@ -378,13 +381,7 @@ fn the_largest_charge_of_the_reference_frame() {
 fn an_unlimited_budget_gives_detects_answer() {
     let scenes: [Vec<u16>; 3] = [
         frame_of(earth_scene),
-        frame_of(|x, y| {
-            if (120..225).contains(&x) && (80..150).contains(&y) {
-                9000
-            } else {
-                0
-            }
-        }),
+        frame_of(bright_box_scene),
         frame_of(|_, _| 700),
     ];
     for px in &scenes {
@@ -468,13 +465,7 @@ fn the_tracking_pass_box_stands_when_the_full_pass_does_not_fit() {
     // A bright box on deep space, the prior over its left edge: the box found in the
     // prior's window (grown by 16 + 50 / 8 = 22 px: 88..162 × 68..162) is cut by the
     // window's right border, so the full frame is searched after it.
-    let px = frame_of(|x, y| {
-        if (120..225).contains(&x) && (80..150).contains(&y) {
-            9000
-        } else {
-            0
-        }
-    });
+    let px = frame_of(bright_box_scene);
     let prior = Roi::new(110, 90, 140, 140);
     let a = Auto::default().with_prior(Some(prior));
     let (full, all) = run(a, &px, WorkBudget::UNLIMITED);
