@@ -301,7 +301,8 @@ fn otsu_split<C: FrameCapacity>(frame: &Frame<'_>, work: &mut OtsuWork<C>) -> u1
 
     // Branch and bound: histogram at full resolution, a few bins per pass, the bins
     // whose bound reaches the best score so far (in order; later passes prune more).
-    let bins_per_pass = (FINE_SLOTS / bin_width).clamp(1, usize::from(NOT_REFINED));
+    // ≥ 1 here (bin_width > 1): the same count the stated pass bound uses.
+    let bins_per_pass = bins_per_pass(frame.bits());
     // Bins that can hold an optimal split (at most MAX_REFINED_BINS): a pass count of
     // at most ⌈MAX_REFINED_BINS / bins_per_pass⌉.
     let mut next_bin = 0;
