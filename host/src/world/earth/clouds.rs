@@ -194,6 +194,12 @@ const GAUSS3: [(f64, f64); 3] = [
     (0.5, 8.0 / 18.0),
     (0.887_298_334_620_741_7, 5.0 / 18.0),
 ];
+/// Every [`GAUSS3`] point of a tile axis: (fraction of the cell in [0, 1], weight), 3
+/// per node interval, in order.
+fn tile_gauss_points() -> impl Iterator<Item = (f64, f64)> {
+    let last = (TILE_NODES - 1) as f64;
+    (0..TILE_NODES - 1).flat_map(move |k| GAUSS3.map(|(x, w)| ((k as f64 + x) / last, w)))
+}
 /// Coarse node grid per cell axis (1/8° spacing, both borders included).
 const NODES: usize = 9;
 /// Lattice table side (values repeat every 32 lattice cells; each octave is rotated and
@@ -597,16 +603,10 @@ impl CloudField {
                 }
             }
         }
-        let last = (TILE_NODES - 1) as f64;
         let lat0 = row as f64 - 90.0;
         // (fraction, Gauss weight, blend weights) of every Gauss point along an axis.
-        let gauss: Vec<(f64, f64, [f64; 3])> = (0..TILE_NODES - 1)
-            .flat_map(|k| {
-                GAUSS3.map(|(x, w)| {
-                    let u = (k as f64 + x) / last;
-                    (u, w, blend_weights(u, BORDER_BLEND_DEG))
-                })
-            })
+        let gauss: Vec<(f64, f64, [f64; 3])> = tile_gauss_points()
+            .map(|(u, w)| (u, w, blend_weights(u, BORDER_BLEND_DEG)))
             .collect();
         // Moments m_k = Σ weight · C(4, k)·w^k·b^(4−k)·σt⁴: flux(s) = Σ m_k s^k / Σ weight.
         let mut m = [0.0f64; 5];
@@ -697,9 +697,7 @@ impl CloudField {
         // The exact cos φ-weighted mean of σT⁴ over the interpolant: 3 × 3 Gauss points
         // in every node interval (the interpolant is bilinear there).
         let (mut sum, mut wsum) = (0.0, 0.0);
-        let gauss: Vec<(f64, f64)> = (0..TILE_NODES - 1)
-            .flat_map(|k| GAUSS3.map(|(x, w)| ((k as f64 + x) / last, w)))
-            .collect();
+        let gauss: Vec<(f64, f64)> = tile_gauss_points().collect();
         for &(u, wu) in &gauss {
             let w = wu * libm::cos((lat0 + u).to_radians());
             let mut line = 0.0;
