@@ -132,19 +132,28 @@ impl DetectorBank {
         repeat: usize,
     ) -> Result<(Detection, f64), DetectError> {
         self.make_room(frame);
-        let mut times = Vec::with_capacity(repeat.max(1));
-        let mut timed = || -> Result<Detection, DetectError> {
-            let start = Instant::now();
-            let d = self.detect(method, frame)?;
-            times.push(start.elapsed().as_secs_f64() * 1e6);
-            Ok(d)
-        };
-        let detection = timed()?;
-        for _ in 1..repeat {
-            timed()?;
-        }
-        Ok((detection, median(&mut times)))
+        timed_median(repeat, || self.detect(method, frame))
     }
+}
+
+/// Runs `call` `repeat` times (at least once): its first result and the median wall
+/// time of one call, in microseconds. Stops at the first error.
+fn timed_median<T, E>(
+    repeat: usize,
+    mut call: impl FnMut() -> Result<T, E>,
+) -> Result<(T, f64), E> {
+    let mut times = Vec::with_capacity(repeat.max(1));
+    let mut timed = || -> Result<T, E> {
+        let start = Instant::now();
+        let r = call()?;
+        times.push(start.elapsed().as_secs_f64() * 1e6);
+        Ok(r)
+    };
+    let first = timed()?;
+    for _ in 1..repeat {
+        timed()?;
+    }
+    Ok((first, median(&mut times)))
 }
 
 impl DetectorBank {
@@ -164,18 +173,9 @@ impl DetectorBank {
     ) -> Result<(Detection, BudgetReport, f64), DetectError> {
         let auto = self.auto;
         let scratch = self.auto_budgeted.get_or_insert_with(Box::default);
-        let mut times = Vec::with_capacity(repeat.max(1));
-        let mut timed = || -> Result<(Detection, BudgetReport), DetectError> {
-            let start = Instant::now();
-            let r = auto.detect_within(frame, scratch, budget)?;
-            times.push(start.elapsed().as_secs_f64() * 1e6);
-            Ok(r)
-        };
-        let (d, report) = timed()?;
-        for _ in 1..repeat {
-            timed()?;
-        }
-        Ok((d, report, median(&mut times)))
+        let ((d, report), time_us) =
+            timed_median(repeat, || auto.detect_within(frame, scratch, budget))?;
+        Ok((d, report, time_us))
     }
 }
 
