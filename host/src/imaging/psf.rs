@@ -215,6 +215,14 @@ impl OpticsPsf {
 mod tests {
     use super::*;
 
+    /// `auto-v2` cuts saturated blobs back by the optics' reach, a core constant (the
+    /// core cannot read the host's): both must name the same kernel.
+    #[test]
+    fn the_detectors_psf_reach_is_this_kernels() {
+        use tirroi_core::roi::auto::learned::saturated;
+        assert_eq!(usize::from(saturated::PSF_RADIUS_PX), PSF_RADIUS_PX);
+    }
+
     #[test]
     fn profile_integrates_to_the_closed_form_encircled_energy() {
         // Brute-force radial integral of the irradiance against 1 − J0² − J1².
