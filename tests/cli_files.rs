@@ -166,6 +166,9 @@ fn a_previous_run_is_replaced_only_with_force_and_resumed_only_when_identical() 
     assert_eq!(manifest["outputs"]["masks"], true);
     assert_eq!(manifest["outputs"]["preview"], false);
     assert_eq!(manifest["tirroi_version"], env!("CARGO_PKG_VERSION"));
+    // The renderer's fingerprint: 16 hex digits (host/build.rs).
+    let renderer = manifest["renderer"].as_str().unwrap();
+    assert!(renderer.len() == 16 && renderer.bytes().all(|b| b.is_ascii_hexdigit()));
     assert_eq!(
         manifest["source"]["file"]["sha256"].as_str().unwrap().len(),
         64

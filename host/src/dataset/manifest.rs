@@ -10,8 +10,9 @@
 //!
 //! The manifest records the resolved configuration (preset name, or scene file path and
 //! SHA-256 of its bytes; the scene description as TOML after `--seed`/`--count`; seed;
-//! image count; outputs; shard) and the tirroi version, and whether the run is
-//! complete. Its bytes are deterministic (no time stamps).
+//! image count; outputs; shard), the tirroi version and the renderer's fingerprint
+//! ([`RENDERER_FINGERPRINT`]), and whether the run is complete. Its bytes are
+//! deterministic (no time stamps).
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -27,6 +28,13 @@ pub const MANIFEST_FILE: &str = "tirroi-run.json";
 
 /// Version of the manifest's layout (bumped when a field changes meaning).
 pub const MANIFEST_FORMAT: u32 = 1;
+
+/// The fingerprint of this build's renderer: 16 hex digits of a SHA-256 over the code that
+/// decides a frame's bytes and labels (scene, world, imaging and dataset stages, presets,
+/// sensor assets, the core's camera model, `Cargo.lock`; comment lines left out),
+/// computed by `host/build.rs`. Two builds with the same fingerprint render the same
+/// frames for the same configuration; a different one means the frames may differ.
+pub const RENDERER_FINGERPRINT: &str = env!("TIRROI_RENDERER_FINGERPRINT");
 
 /// The label files a run writes beside its images.
 pub const LABEL_FILES: [&str; 3] = ["truth.csv", "coco.json", "metadata.jsonl"];
@@ -115,6 +123,10 @@ pub struct Manifest {
     pub format: u32,
     /// Version of the tirroi that rendered the run (`CARGO_PKG_VERSION`).
     pub tirroi_version: String,
+    /// [`RENDERER_FINGERPRINT`] of the build that rendered the run (empty in manifests
+    /// written before it was recorded: such a run never matches a current build).
+    #[serde(default)]
+    pub renderer: String,
     /// Preset or scene file.
     pub source: RunSource,
     /// Dataset name (`[dataset] name`).
@@ -146,6 +158,7 @@ impl Manifest {
         Ok(Manifest {
             format: MANIFEST_FORMAT,
             tirroi_version: env!("CARGO_PKG_VERSION").into(),
+            renderer: RENDERER_FINGERPRINT.into(),
             source,
             name: file.dataset.name.clone(),
             seed: file.dataset.seed,
@@ -167,6 +180,20 @@ impl Manifest {
             d.push(format!(
                 "it was rendered by tirroi {}, this is {}",
                 self.tirroi_version, other.tirroi_version
+            ));
+        }
+        if self.renderer != other.renderer {
+            let of = |r: &str| {
+                if r.is_empty() {
+                    "a renderer without a recorded fingerprint".to_string()
+                } else {
+                    format!("renderer {r}")
+                }
+            };
+            d.push(format!(
+                "it was rendered by {}, this build's is {}",
+                of(&self.renderer),
+                of(&other.renderer)
             ));
         }
         match (&self.source, &other.source) {
@@ -450,6 +477,47 @@ mod tests {
         for i in 0..30 {
             assert_eq!(parts.iter().filter(|s| s.contains(i)).count(), 1);
         }
+    }
+
+    /// A manifest of a preset run, as this build writes it.
+    fn this_build() -> Manifest {
+        let file = crate::world::scene::SceneFile::preset("quick").unwrap();
+        let outputs = Outputs {
+            masks: false,
+            preview: false,
+        };
+        Manifest::new(RunSource::Preset("quick".into()), &file, outputs, None).unwrap()
+    }
+
+    #[test]
+    fn a_run_of_other_renderer_code_is_another_run() {
+        let now = this_build();
+        assert_eq!(now.renderer, RENDERER_FINGERPRINT);
+        assert_eq!(RENDERER_FINGERPRINT.len(), 16);
+        assert!(RENDERER_FINGERPRINT.bytes().all(|b| b.is_ascii_hexdigit()));
+        assert!(now.differences(&now).is_empty());
+        let other = Manifest {
+            renderer: "0123456789abcdef".into(),
+            ..now.clone()
+        };
+        assert_eq!(
+            other.differences(&now),
+            [format!(
+                "it was rendered by renderer 0123456789abcdef, this build's is renderer {RENDERER_FINGERPRINT}"
+            )]
+        );
+        // A manifest written before the fingerprint was recorded still reads, and is
+        // never taken for this build's run.
+        let mut json: serde_json::Value = serde_json::to_value(&now).unwrap();
+        json.as_object_mut().unwrap().remove("renderer");
+        let old: Manifest = serde_json::from_value(json).unwrap();
+        assert_eq!(old.renderer, "");
+        assert_eq!(
+            old.differences(&now),
+            [format!(
+                "it was rendered by a renderer without a recorded fingerprint, this build's is renderer {RENDERER_FINGERPRINT}"
+            )]
+        );
     }
 
     #[test]
