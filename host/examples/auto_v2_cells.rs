@@ -10,7 +10,8 @@
 //! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
 //! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
-//! boxed: the confidence model's training data). Optional further arguments set
+//! boxed: the confidence model's training data; the winner's statistics end with its
+//! shape, `learned::shape::WinnerShape`). Optional further arguments set
 //! the cell threshold (`AutoV2::cell_score`, score units) and the saturated blob's
 //! cut (`AutoV2::saturated_erode_px`, px per side).
 use std::fmt::Write as _;
@@ -139,7 +140,7 @@ fn main() {
                     Some(w) => {
                         let _ = writeln!(
                             s,
-                            ",{},{},{},{},{},{},{},{}",
+                            ",{},{},{},{},{},{},{},{},{},{},{}",
                             w.cells,
                             w.box_w_cells,
                             w.box_h_cells,
@@ -147,10 +148,13 @@ fn main() {
                             w.code_sum,
                             w.code_max,
                             w.components,
-                            w.runner_up_permille
+                            w.runner_up_permille,
+                            w.shape.perimeter_cells,
+                            w.shape.contrast_code,
+                            w.shape.clutter_code
                         );
                     }
-                    None => s.push_str(",,,,,,,,\n"),
+                    None => s.push_str(",,,,,,,,,,,\n"),
                 }
             }
             s
@@ -163,7 +167,8 @@ fn main() {
         }
         h
     } else {
-        "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up"
+        "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up,\
+             perimeter,contrast_code,clutter_code"
             .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");

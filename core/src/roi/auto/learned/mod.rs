@@ -7,8 +7,10 @@
 //! wins, and its cells gate `auto`'s full-resolution refinement (outermost boundaries,
 //! saturated targets); a small box is then cut to its half maximum ([`half_max`]: far
 //! targets' blur) and a saturated blob by the optics' reach ([`saturated`]).
-//! A box's confidence is a logistic model over the winner's statistics (box size,
-//! fill, sides touched, best cell score, components), fitted on our renders
+//! A box's confidence is a logistic model of P(hit) over statistics of the winner
+//! itself (its cells, sides touched, mean cell score and the contrast of its border
+//! against the ring of background around it in the ring's own spread, [`shape`]; none
+//! counts the background's other components), fitted on our renders
 //! (`confidence_weights.rs`).
 //!
 //! Unlike `auto`'s "the outline is a step" rule, the region stage learns what the
@@ -22,6 +24,7 @@ pub mod forest;
 mod forest_trees;
 pub mod half_max;
 pub mod saturated;
+pub mod shape;
 
 use super::super::plane::Window;
 use super::super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
@@ -46,9 +49,11 @@ pub struct AutoV2 {
     /// −512 with its own refitted confidence model and its lowest gate within the
     /// false-alarm bound, 0 gives the best summed mean IoU (1.908 vs 1.854 and 1.848).
     pub cell_score: i16,
-    /// Boxes whose confidence is below this are dropped (no target), ‰: 0..=1000.
-    /// Default 650: on family A, the lowest threshold in steps of 50 whose false alarms
-    /// over all its 124 no-target frames stay ≤ 2 % (1 of 124; 600: 3).
+    /// Boxes whose confidence (a calibrated P(hit), [`Winner::score_permille`]) is
+    /// below this are dropped (no target), ‰: 0..=1000. Default 550: on family A
+    /// (famA25, paperAm, fixA), the lowest threshold in steps of 50 whose false alarms
+    /// stay ≤ 2 % on the no-target frames of every kind (realistic 1 of 60, fixtures 0
+    /// of 80; 500: realistic 2 of 60).
     pub min_score_permille: u16,
     /// A box that is a saturated blob is cut by this many pixels per side (off the
     /// frame's edges; [`saturated`]), px: 0..=8. A property of the camera: the reach of
@@ -65,7 +70,7 @@ impl Default for AutoV2 {
         AutoV2 {
             fine_sigma: 8,
             cell_score: 0,
-            min_score_permille: 650,
+            min_score_permille: 550,
             saturated_erode_px: 2,
         }
     }
@@ -91,16 +96,27 @@ pub struct Winner {
     pub components: u16,
     /// The runner-up's summed energy relative to the winner's, ‰ (0: no runner-up).
     pub runner_up_permille: u16,
+    /// Its outline and border contrast ([`shape::winner_shape`]).
+    pub shape: shape::WinnerShape,
 }
+
+/// Number of the confidence model's features ([`Winner::confidence_features`]).
+pub const CONFIDENCE_FEATURES: usize = 11;
 
 impl Winner {
     /// The confidence model's integer features (`scripts/train-auto.py` computes the
     /// same from the training dumps): log codes of the cells and of the cell box's
     /// area, the box's fill ‰, sides touched, the mean code × 16, the best code, the
-    /// log code of the component count, the runner-up ‰.
-    pub fn confidence_features(&self) -> [i32; 8] {
+    /// log code of the component count, the runner-up ‰, and the winner's own shape
+    /// ([`shape::WinnerShape`]): compactness ‰ (16 · cells / perimeter², 1000 for a
+    /// square, capped there), the border contrast in σ and in the ring's spread (log
+    /// codes). Which of them the model uses is `confidence_weights.rs`' choice (weight 0:
+    /// unused).
+    pub fn confidence_features(&self) -> [i32; CONFIDENCE_FEATURES] {
         let cells = u32::from(self.cells).max(1);
         let area = u32::from(self.box_w_cells) * u32::from(self.box_h_cells);
+        let perimeter = u64::from(self.shape.perimeter_cells).max(1);
+        let compact = (16 * u64::from(cells) * 1000 / (perimeter * perimeter)).min(1000);
         [
             features::log_code(cells - 1),
             features::log_code(area.max(1) - 1),
@@ -110,6 +126,9 @@ impl Winner {
             i32::from(self.code_max),
             features::log_code(u32::from(self.components)),
             i32::from(self.runner_up_permille),
+            compact as i32,
+            i32::from(self.shape.contrast_code),
+            i32::from(self.shape.clutter_code),
         ]
     }
 
@@ -376,12 +395,32 @@ impl AutoV2 {
         {
             let labels8 = &work.labels8.as_ref()[..n8];
             let codes = &work.labels4.as_ref()[..n8];
-            for (&l, &c) in labels8.iter().zip(codes) {
-                if l != 0 && work.comps.find(l) == root {
+            // The winner's cells marked in `dilated4` (free until stage 5's gate) for
+            // its shape statistics.
+            let member = work.dilated4.as_mut();
+            for (i, (&l, &c)) in labels8.iter().zip(codes).enumerate() {
+                let is_winner = l != 0 && work.comps.find(l) == root;
+                if is_winner {
                     code_sum += u32::from(c);
+                }
+                if let Some(m) = member.get_mut(i) {
+                    *m = u8::from(is_winner);
                 }
             }
         }
+        let shape = shape::winner_shape(
+            work.dilated4.as_ref().get(..n8).unwrap_or_default(),
+            &work.labels4.as_ref()[..n8],
+            &work.mean_dn.as_ref()[..n8],
+            plane8,
+            (
+                usize::from(w8.x0),
+                usize::from(w8.y0),
+                usize::from(w8.x_last),
+                usize::from(w8.y_last),
+            ),
+            lv.sigma,
+        );
         work.winner = Some(Winner {
             cells: w8.area,
             box_w_cells: w8.x_last - w8.x0 + 1,
@@ -392,6 +431,7 @@ impl AutoV2 {
             components,
             runner_up_permille: (u64::from(runner_up) * 1000 / u64::from(w8.energy.max(1)))
                 .min(1000) as u16,
+            shape,
         });
         let score_permille = work.winner.map_or(0, |w| w.score_permille());
         if score_permille < self.min_score_permille {
@@ -801,10 +841,24 @@ mod tests {
                 code_max: 20,
                 components: comps,
                 runner_up_permille: runner,
+                shape: shape::WinnerShape {
+                    perimeter_cells: 4 * u16::from(w),
+                    contrast_code: 40,
+                    clutter_code: 20,
+                },
             };
             let f = win.confidence_features();
             assert_eq!(f[0], log_code(u32::from(cells) - 1));
             assert_eq!(f[4], 9 * 16);
+            // Compactness: 16 · cells / perimeter², capped at a square's 1000.
+            let p = f64::from(4 * u32::from(w));
+            assert_eq!(
+                f64::from(f[8]),
+                (16.0 * f64::from(cells) * 1000.0 / (p * p))
+                    .floor()
+                    .min(1000.0)
+            );
+            assert_eq!((f[9], f[10]), (40, 20));
             let z: f64 = f
                 .iter()
                 .zip(confidence_weights::WEIGHTS)
