@@ -65,6 +65,28 @@ fn main() {
         .get(5)
         .map(|v| v.parse::<u8>().expect("saturated_erode_px: 0..=8"))
         .unwrap_or(AutoV2::default().saturated_erode_px);
+    // Optional: the body stage's parameters (`BodyParams`): k_sigma, ring_from_cells,
+    // ring_to_cells, max_share_permille, trim_permille (default: `AutoV2::default()`'s).
+    let mut body = AutoV2::default().body;
+    let num = |k: usize| {
+        args.get(k)
+            .map(|v| v.parse::<u16>().expect("body: integers"))
+    };
+    if let Some(v) = num(6) {
+        body.k_sigma = v;
+    }
+    if let Some(v) = num(7) {
+        body.ring_from_cells = v as u8;
+    }
+    if let Some(v) = num(8) {
+        body.ring_to_cells = v as u8;
+    }
+    if let Some(v) = num(9) {
+        body.max_share_permille = v;
+    }
+    if let Some(v) = num(10) {
+        body.trim_permille = v;
+    }
     let list = frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -116,6 +138,7 @@ fn main() {
                     },
                     cell_score,
                     saturated_erode_px: erode,
+                    body,
                     ..AutoV2::default()
                 };
                 let d = gate_off.detect(&frame, &mut scratch).expect("detect");

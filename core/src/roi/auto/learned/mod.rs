@@ -15,6 +15,7 @@
 //! background looks like (cloud texture, the limb, a real camera's shading and hot
 //! pixels) from our renders, and a cloud edge touching the target is not part of it.
 
+pub mod body;
 mod cells;
 mod confidence_weights;
 pub mod features;
@@ -58,6 +59,9 @@ pub struct AutoV2 {
     /// 0, 1, 2, 3). Set 0 for a camera without optics blur (the `paper` world, the
     /// fixtures and the test-set composites: there 0 is best, 2 costs 0.20 and 0.05).
     pub saturated_erode_px: u8,
+    /// The whole body grown from the winner ([`body`]: faces hotter and colder than
+    /// the background joined to it). [`body::BodyParams::OFF`] turns it off.
+    pub body: body::BodyParams,
 }
 
 impl Default for AutoV2 {
@@ -67,6 +71,7 @@ impl Default for AutoV2 {
             cell_score: 0,
             min_score_permille: 650,
             saturated_erode_px: 2,
+            body: body::BodyParams::DEFAULT,
         }
     }
 }
@@ -470,9 +475,34 @@ impl AutoV2 {
                 y1: px(usize::from(w8.y_last) + 1, fh),
             })
         });
-        // Stage 6: small boxes cut to their half maximum (far targets' blur).
+        // Stage 6: the whole body, grown from the winner's cells over cells hotter or
+        // colder than the ring around them (`labels4` is free after the refinement).
+        // A saturated blob is a whole target already (stage 8 cuts it).
+        let roi = roi.map(|r| {
+            if saturated::is_saturated_blob(frame, r) {
+                return r;
+            }
+            let marks = &mut work.labels4.as_mut()[..n8];
+            for (m, &l) in marks.iter_mut().zip(&work.labels8.as_ref()[..n8]) {
+                *m = if l != 0 && work.comps.find(l) == root {
+                    body::WINNER
+                } else {
+                    0
+                };
+            }
+            body::body_box(
+                frame,
+                &work.mean_dn.as_ref()[..n8],
+                marks,
+                plane8,
+                lv.sigma,
+                r,
+                self.body,
+            )
+        });
+        // Stage 7: small boxes cut to their half maximum (far targets' blur).
         let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
-        // Stage 7: a saturated blob cut back by the optics' spread.
+        // Stage 8: a saturated blob cut back by the optics' spread.
         let roi =
             roi.map(|r| saturated::saturated_box(frame, r, u16::from(self.saturated_erode_px)));
         Detection {
@@ -488,8 +518,18 @@ impl core::fmt::Display for AutoV2 {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={}",
-            self.fine_sigma, self.cell_score, self.min_score_permille, self.saturated_erode_px
+            "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
+             body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
+             body_trim_permille={}",
+            self.fine_sigma,
+            self.cell_score,
+            self.min_score_permille,
+            self.saturated_erode_px,
+            self.body.k_sigma,
+            self.body.ring_from_cells,
+            self.body.ring_to_cells,
+            self.body.max_share_permille,
+            self.body.trim_permille
         )
     }
 }
@@ -521,6 +561,13 @@ impl Detector for AutoV2 {
             return Err(DetectError::InvalidParameter {
                 name: "saturated_erode_px",
                 expected: "0..=8 (pixels per side)",
+            });
+        }
+        if !self.body.is_valid() {
+            return Err(DetectError::InvalidParameter {
+                name: "body",
+                expected: "k_sigma 0..=100, ring 1..=8 to ..=16 cells, \
+                           max_share_permille 1..=1000, trim_permille 0..=1000",
             });
         }
         Ok(())
