@@ -11,8 +11,10 @@
 //! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
 //! boxed: the confidence model's training data). Optional further arguments set
-//! the cell threshold (`AutoV2::cell_score`, score units) and the saturated blob's
-//! cut (`AutoV2::saturated_erode_px`, px per side).
+//! the cell threshold (`AutoV2::cell_score`, score units), the saturated blob's
+//! cut (`AutoV2::saturated_erode_px`, px per side) and the body stage's parameters
+//! (`BodyParams`: k_sigma, ring_from_cells, ring_to_cells, max_share_permille,
+//! trim_permille; `k_sigma` 0 turns the stage off).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

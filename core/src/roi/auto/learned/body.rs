@@ -63,9 +63,9 @@ pub struct BodyParams {
 impl BodyParams {
     /// The default (family A's choice).
     pub const DEFAULT: BodyParams = BodyParams {
-        k_sigma: 4,
-        ring_from_cells: 1,
-        ring_to_cells: 3,
+        k_sigma: 3,
+        ring_from_cells: 2,
+        ring_to_cells: 5,
         max_share_permille: 250,
         trim_permille: 100,
     };

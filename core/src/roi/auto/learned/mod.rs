@@ -5,8 +5,10 @@
 //! within the frame, steps, contrast against boxes of 8–64 px and their texture); the
 //! target cells are grouped into 8-connected components, the strongest (summed score)
 //! wins, and its cells gate `auto`'s full-resolution refinement (outermost boundaries,
-//! saturated targets); a small box is then cut to its half maximum ([`half_max`]: far
-//! targets' blur) and a saturated blob by the optics' reach ([`saturated`]).
+//! saturated targets); the box is grown to the whole body ([`body`]: faces hotter and
+//! colder than the background joined to the winner), a small box is then cut to its
+//! half maximum ([`half_max`]: far targets' blur) and a saturated blob by the optics'
+//! reach ([`saturated`]).
 //! A box's confidence is a logistic model over the winner's statistics (box size,
 //! fill, sides touched, best cell score, components), fitted on our renders
 //! (`confidence_weights.rs`).
