@@ -78,10 +78,10 @@ fn main() {
         body.k_sigma = v;
     }
     if let Some(v) = num(7) {
-        body.ring_from_cells = v as u8;
+        body.ring_from_cells = u8::try_from(v).expect("ring_from_cells: 1..=8");
     }
     if let Some(v) = num(8) {
-        body.ring_to_cells = v as u8;
+        body.ring_to_cells = u8::try_from(v).expect("ring_to_cells: ..=16");
     }
     if let Some(v) = num(9) {
         body.max_share_permille = v;
