@@ -138,7 +138,8 @@ impl Winner {
 }
 
 /// `auto-v2`'s buffers (planes of 8×8 cells: `HalfCells`; of 4×4 cells: `Cells`).
-/// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate.
+/// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate, then
+/// the body stage's marks of 8×8 cells ([`body`]).
 #[derive(Debug, Clone)]
 pub struct AutoV2Work<C: FrameCapacity = Reference> {
     mean_dn: C::HalfCells<u16>,
