@@ -12,8 +12,10 @@
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
 //! boxed: the confidence model's training data; the winner's statistics end with its
 //! shape, `learned::shape::WinnerShape`). Optional further arguments set
-//! the cell threshold (`AutoV2::cell_score`, score units) and the saturated blob's
-//! cut (`AutoV2::saturated_erode_px`, px per side).
+//! the cell threshold (`AutoV2::cell_score`, score units), the saturated blob's
+//! cut (`AutoV2::saturated_erode_px`, px per side) and the body stage's parameters
+//! (`BodyParams`: k_sigma, ring_from_cells, ring_to_cells, max_share_permille,
+//! trim_permille; `k_sigma` 0 turns the stage off).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -66,6 +68,28 @@ fn main() {
         .get(5)
         .map(|v| v.parse::<u8>().expect("saturated_erode_px: 0..=8"))
         .unwrap_or(AutoV2::default().saturated_erode_px);
+    // Optional: the body stage's parameters (`BodyParams`): k_sigma, ring_from_cells,
+    // ring_to_cells, max_share_permille, trim_permille (default: `AutoV2::default()`'s).
+    let mut body = AutoV2::default().body;
+    let num = |k: usize| {
+        args.get(k)
+            .map(|v| v.parse::<u16>().expect("body: integers"))
+    };
+    if let Some(v) = num(6) {
+        body.k_sigma = v;
+    }
+    if let Some(v) = num(7) {
+        body.ring_from_cells = u8::try_from(v).expect("ring_from_cells: 1..=8");
+    }
+    if let Some(v) = num(8) {
+        body.ring_to_cells = u8::try_from(v).expect("ring_to_cells: ..=16");
+    }
+    if let Some(v) = num(9) {
+        body.max_share_permille = v;
+    }
+    if let Some(v) = num(10) {
+        body.trim_permille = v;
+    }
     let list = frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -117,6 +141,7 @@ fn main() {
                     },
                     cell_score,
                     saturated_erode_px: erode,
+                    body,
                     ..AutoV2::default()
                 };
                 let d = gate_off.detect(&frame, &mut scratch).expect("detect");

@@ -5,8 +5,10 @@
 //! within the frame, steps, contrast against boxes of 8–64 px and their texture); the
 //! target cells are grouped into 8-connected components, the strongest (summed score)
 //! wins, and its cells gate `auto`'s full-resolution refinement (outermost boundaries,
-//! saturated targets); a small box is then cut to its half maximum ([`half_max`]: far
-//! targets' blur) and a saturated blob by the optics' reach ([`saturated`]).
+//! saturated targets); the box is grown to the whole body ([`body`]: faces hotter and
+//! colder than the background joined to the winner), a small box is then cut to its
+//! half maximum ([`half_max`]: far targets' blur) and a saturated blob by the optics'
+//! reach ([`saturated`]).
 //! A box's confidence is a logistic model of P(hit) over statistics of the winner
 //! itself (its cells, sides touched, mean cell score and the contrast of its border
 //! against the ring of background around it in the ring's own spread, [`shape`]; none
@@ -17,6 +19,7 @@
 //! background looks like (cloud texture, the limb, a real camera's shading and hot
 //! pixels) from our renders, and a cloud edge touching the target is not part of it.
 
+pub mod body;
 mod cells;
 mod confidence_weights;
 pub mod features;
@@ -63,6 +66,9 @@ pub struct AutoV2 {
     /// 0, 1, 2, 3). Set 0 for a camera without optics blur (the `paper` world, the
     /// fixtures and the test-set composites: there 0 is best, 2 costs 0.20 and 0.05).
     pub saturated_erode_px: u8,
+    /// The whole body grown from the winner ([`body`]: faces hotter and colder than
+    /// the background joined to it). [`body::BodyParams::OFF`] turns it off.
+    pub body: body::BodyParams,
 }
 
 impl Default for AutoV2 {
@@ -72,6 +78,7 @@ impl Default for AutoV2 {
             cell_score: 0,
             min_score_permille: 550,
             saturated_erode_px: 2,
+            body: body::BodyParams::DEFAULT,
         }
     }
 }
@@ -150,7 +157,8 @@ impl Winner {
 }
 
 /// `auto-v2`'s buffers (planes of 8×8 cells: `HalfCells`; of 4×4 cells: `Cells`).
-/// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate.
+/// `labels4` first holds the 8×8 cells' class codes (stage 3), then the 4×4 gate, then
+/// the body stage's marks of 8×8 cells ([`body`]).
 #[derive(Debug, Clone)]
 pub struct AutoV2Work<C: FrameCapacity = Reference> {
     mean_dn: C::HalfCells<u16>,
@@ -510,9 +518,34 @@ impl AutoV2 {
                 y1: px(usize::from(w8.y_last) + 1, fh),
             })
         });
-        // Stage 6: small boxes cut to their half maximum (far targets' blur).
+        // Stage 6: the whole body, grown from the winner's cells over cells hotter or
+        // colder than the ring around them (`labels4` is free after the refinement).
+        // A saturated blob is a whole target already (stage 8 cuts it).
+        let roi = roi.map(|r| {
+            if saturated::is_saturated_blob(frame, r) {
+                return r;
+            }
+            let marks = &mut work.labels4.as_mut()[..n8];
+            for (m, &l) in marks.iter_mut().zip(&work.labels8.as_ref()[..n8]) {
+                *m = if l != 0 && work.comps.find(l) == root {
+                    body::WINNER
+                } else {
+                    0
+                };
+            }
+            body::body_box(
+                frame,
+                &work.mean_dn.as_ref()[..n8],
+                marks,
+                plane8,
+                lv.sigma,
+                r,
+                self.body,
+            )
+        });
+        // Stage 7: small boxes cut to their half maximum (far targets' blur).
         let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
-        // Stage 7: a saturated blob cut back by the optics' spread.
+        // Stage 8: a saturated blob cut back by the optics' spread.
         let roi =
             roi.map(|r| saturated::saturated_box(frame, r, u16::from(self.saturated_erode_px)));
         Detection {
@@ -528,8 +561,18 @@ impl core::fmt::Display for AutoV2 {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={}",
-            self.fine_sigma, self.cell_score, self.min_score_permille, self.saturated_erode_px
+            "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
+             body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
+             body_trim_permille={}",
+            self.fine_sigma,
+            self.cell_score,
+            self.min_score_permille,
+            self.saturated_erode_px,
+            self.body.k_sigma,
+            self.body.ring_from_cells,
+            self.body.ring_to_cells,
+            self.body.max_share_permille,
+            self.body.trim_permille
         )
     }
 }
@@ -561,6 +604,13 @@ impl Detector for AutoV2 {
             return Err(DetectError::InvalidParameter {
                 name: "saturated_erode_px",
                 expected: "0..=8 (pixels per side)",
+            });
+        }
+        if !self.body.is_valid() {
+            return Err(DetectError::InvalidParameter {
+                name: "body",
+                expected: "k_sigma 0..=100, ring 1..=8 to ..=16 cells, \
+                           max_share_permille 1..=1000, trim_permille 0..=1000",
             });
         }
         Ok(())

@@ -78,25 +78,41 @@ fn cut_span(a: u16, b: u16, e: u16, limit: u16) -> (u16, u16) {
     }
 }
 
+/// The box of the saturated pixels of `roi` when `roi` is a saturated blob: at least
+/// [`MIN_BLOB_PX`] pixels at the top DN, `roi` reaching at most [`PSF_RADIUS_PX`] + 1
+/// px beyond their box on every side (the blob and its halo, not a larger body with a
+/// saturated face); `None` otherwise.
+fn blob_hull(frame: &Frame<'_>, roi: Roi) -> Option<Roi> {
+    if roi.x1 <= roi.x0 || roi.y1 <= roi.y0 {
+        return None;
+    }
+    let (hull, n) = saturated_hull(frame, roi);
+    if n < MIN_BLOB_PX {
+        return None;
+    }
+    let reach = PSF_RADIUS_PX + 1;
+    // The hull lies inside `roi` (it holds ≥ 4 of its pixels): no underflow.
+    let halo_only = hull.x0 - roi.x0 <= reach
+        && hull.y0 - roi.y0 <= reach
+        && roi.x1 - hull.x1 <= reach
+        && roi.y1 - hull.y1 <= reach;
+    halo_only.then_some(hull)
+}
+
+/// True when `roi` is a saturated blob and its halo ([`saturated_box`] cuts it).
+pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
+    blob_hull(frame, roi).is_some()
+}
+
 /// `roi` cut to the saturated target inside it (see the module): when `roi` holds at
 /// least [`MIN_BLOB_PX`] pixels at the top DN and reaches at most
 /// [`PSF_RADIUS_PX`] + 1 px beyond their box on every side (it is that blob and its
 /// halo, not a larger body with a saturated face), the blob's box cut by `erode_px` per
 /// side off the frame's edges; otherwise `roi` unchanged. The result lies inside `roi`.
 pub fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
-    if roi.x1 <= roi.x0 || roi.y1 <= roi.y0 {
+    let Some(hull) = blob_hull(frame, roi) else {
         return roi;
-    }
-    let (hull, n) = saturated_hull(frame, roi);
-    let reach = PSF_RADIUS_PX + 1;
-    if n < MIN_BLOB_PX
-        || hull.x0 - roi.x0 > reach
-        || hull.y0 - roi.y0 > reach
-        || roi.x1 - hull.x1 > reach
-        || roi.y1 - hull.y1 > reach
-    {
-        return roi;
-    }
+    };
     let (fw, fh) = (frame.width() as u16, frame.height() as u16);
     let (x0, x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
     let (y0, y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
