@@ -297,7 +297,7 @@ crate::detector_registry! {
     /// The parameters of one detector (which one says [`Params::method`]).
     pub enum Params;
     /// Every detector's scratch memory in one place: [`Detectors::detect`] runs the
-    /// detector of a [`Params`] in its own scratch. 141 KB on x86-64 (the sum of the
+    /// detector of a [`Params`] in its own scratch. 190 KB on x86-64 (the sum of the
     /// scratch sizes); a `static` on flight hardware, boxed on the host.
     pub struct Detectors;
     /// [`otsu::Otsu`].

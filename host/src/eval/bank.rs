@@ -14,7 +14,7 @@ use crate::world::scene::SceneFile;
 
 /// Every registered detector (the core's registry, [`Method::ALL`]) with its
 /// parameters and its scratch memory, ready to run frame after frame: the 328×248
-/// bank (boxed: about 184 KB) and, made on the first frame that needs them, the
+/// bank (boxed: about 190 KB) and, made on the first frame that needs them, the
 /// 640×512 and 1024×768 banks; the smallest that holds a frame runs it.
 pub struct DetectorBank {
     /// The parameters of each method at [`Method::index`]; `auto`'s slot is unused
