@@ -154,7 +154,7 @@ fn detect_json_all_methods_and_files() {
         let want = library_detection(method, file);
         assert_eq!(bbox, want.roi.map(|r| r.to_array()), "{line}");
     }
-    // The default method is all five.
+    // The default method is all of them.
     let out = run(&["detect", "--json", files[0].to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr_text(&out));
     assert_eq!(stdout_lines(&out).len(), n);

@@ -10,6 +10,7 @@ use std::path::Path;
 
 use cli_common::run;
 use serde_json::Value;
+use tirroi::core::Method;
 use tirroi::host::dataset::{Library, plan};
 use tirroi::host::eval::scoring::read_truth;
 use tirroi::host::world::scene::SceneFile;
@@ -293,7 +294,7 @@ fn eval_scores_target_frames_and_false_alarms() {
         assert!((f("false_alarm_rate") - *alarms as f64 / 3.0).abs() <= 1e-4);
         checked += 1;
     }
-    assert_eq!(checked, 5, "the five methods");
+    assert_eq!(checked, Method::ALL.len(), "every registered method");
     // The `target = none` group: no target frame, only false alarms.
     for r in summary
         .iter()

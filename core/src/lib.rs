@@ -60,6 +60,7 @@
 //! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 352 | 16 KiB |
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 296 | 96 KiB |
 //! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 456 | 32 KiB |
+//! | auto-v2 | [`roi::auto::learned::AutoV2Scratch`] | [`roi::auto::learned::SCRATCH_BYTES`] = 48 680 | 48 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
 //!

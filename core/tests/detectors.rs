@@ -1334,7 +1334,7 @@ fn two_blobs_on_a_full_frame() {
 
 /// lib.rs's memory table: (detector, its `SCRATCH_BYTES`, what `Method` reports, the
 /// budget, the exact bytes on x86-64). Stated numbers, not recomputed from the types.
-const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 4] = [
+const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 5] = [
     ("otsu", otsu::SCRATCH_BYTES, Method::Otsu, 16 * 1024, 15_224),
     (
         "adaptive",
@@ -1345,6 +1345,13 @@ const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 4] = [
     ),
     ("wge", wge::SCRATCH_BYTES, Method::Wge, 16 * 1024, 14_352),
     ("dog", dog::SCRATCH_BYTES, Method::Dog, 96 * 1024, 74_296),
+    (
+        "auto-v2",
+        tirroi_core::roi::auto::learned::SCRATCH_BYTES,
+        Method::AutoV2,
+        48 * 1024,
+        48_680,
+    ),
 ];
 
 #[test]
@@ -1386,14 +1393,14 @@ fn scratch_memory_is_as_documented_on_64_bit() {
 
 #[test]
 fn method_names_round_trip() {
-    assert_eq!(Method::ALL.len(), 5);
+    assert_eq!(Method::ALL.len(), 6);
     assert_eq!(
         Method::PAPER,
         [Method::Otsu, Method::Adaptive, Method::Wge, Method::Dog]
     );
     for (m, name) in Method::ALL
         .into_iter()
-        .zip(["otsu", "adaptive", "wge", "dog", "auto"])
+        .zip(["otsu", "adaptive", "wge", "dog", "auto", "auto-v2"])
     {
         assert_eq!(m.name(), name);
         assert_eq!(m.to_string(), name);

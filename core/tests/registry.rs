@@ -1,7 +1,7 @@
 //! The detector registry: adding a detector is its module plus one registry entry.
 //!
 //! A toy detector (`peak`: pixels within `band_dn` of the frame's brightest DN) is
-//! registered beside the core's five in a registry of this test's own; everything that
+//! registered beside the core's six in a registry of this test's own; everything that
 //! dispatches on a method (names, parsing, scratch bytes, defaults, validation, the
 //! scratch bank) comes from that one entry, and the toy's box is checked against a
 //! brute-force box of the same rule.
@@ -90,7 +90,7 @@ impl Detector for Peak {
 }
 
 tirroi_core::detector_registry! {
-    /// The core's five and the toy.
+    /// The core's six and the toy.
     pub enum Method;
     /// Their parameters.
     pub enum Params;
@@ -106,6 +106,8 @@ tirroi_core::detector_registry! {
     Dog(dog) => roi::dog::Dog,
     /// auto.
     Auto(auto) => roi::auto::Auto,
+    /// auto-v2.
+    AutoV2(auto_v2) => roi::auto::learned::AutoV2,
     /// The toy: the one line that adds it.
     Peak(peak) => Peak,
 }
@@ -173,10 +175,13 @@ fn brute_force(px: &[u16], w: usize, h: usize, t: u16) -> (Option<Roi>, Option<R
 
 #[test]
 fn one_entry_gives_names_parsing_defaults_and_scratch_bytes() {
-    assert_eq!(Method::ALL.len(), 6);
-    assert_eq!(Method::ALL[5], Method::Peak);
+    assert_eq!(Method::ALL.len(), 7);
+    assert_eq!(Method::ALL[6], Method::Peak);
     let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-    assert_eq!(names, ["otsu", "adaptive", "wge", "dog", "auto", "peak"]);
+    assert_eq!(
+        names,
+        ["otsu", "adaptive", "wge", "dog", "auto", "auto-v2", "peak"]
+    );
     for m in Method::ALL {
         assert_eq!(Method::from_name(m.name()), Some(m));
         assert_eq!(m.to_string(), m.name());
@@ -184,7 +189,7 @@ fn one_entry_gives_names_parsing_defaults_and_scratch_bytes() {
         assert!(m.default_params().validate().is_ok(), "{m}");
     }
     assert_eq!(Method::from_name("Peak"), None);
-    // The core's five keep their registry's sizes; the toy's is its scratch type's.
+    // The core's six keep their registry's sizes; the toy's is its scratch type's.
     for (mine, core) in Method::ALL.iter().zip(tirroi_core::Method::ALL) {
         assert_eq!(mine.name(), core.name());
         assert_eq!(mine.scratch_bytes(), core.scratch_bytes());

@@ -73,7 +73,7 @@ DN bit depth."""
 
 def methods() -> List[str]:
     """The detectors' names in registry order (``tirroi_core::Method::ALL``), e.g.
-    ``['otsu', 'adaptive', 'wge', 'dog', 'auto']``; any of them is a ``method`` of
+    ``['otsu', 'adaptive', 'wge', 'dog', 'auto', 'auto-v2']``; any of them is a ``method`` of
     :func:`detect`."""
     return list(_native.methods())
 

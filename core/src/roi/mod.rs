@@ -9,7 +9,9 @@
 //! - [`wge`]: weak gradient elimination (Prewitt gradients, drop the weakest fraction);
 //! - [`dog`]: difference-of-Gaussians blob detection over space and scale;
 //! - [`auto`]: ours, scene-aware: picks the target's outline among coarse edge
-//!   components and refines it at full resolution, optionally in a tracking window.
+//!   components and refines it at full resolution, optionally in a tracking window;
+//!   `auto-v2` ([`auto::learned`]) is its development successor (a learned region
+//!   stage and a confidence), registered beside it.
 //!
 //! A detector is a small `Copy` parameter struct implementing [`Detector`]; its
 //! working memory is a [`Scratch`] the caller owns, of a size known at compile time.
@@ -290,12 +292,12 @@ pub trait Detector: Sized {
 
 crate::detector_registry! {
     /// The detectors by name, for command lines, configuration and telemetry: the
-    /// paper's four in its order, then `auto`.
+    /// paper's four in its order, then `auto` and its development successor `auto-v2`.
     pub enum Method;
     /// The parameters of one detector (which one says [`Params::method`]).
     pub enum Params;
     /// Every detector's scratch memory in one place: [`Detectors::detect`] runs the
-    /// detector of a [`Params`] in its own scratch. 141 KB on x86-64 (the sum of the
+    /// detector of a [`Params`] in its own scratch. 190 KB on x86-64 (the sum of the
     /// scratch sizes); a `static` on flight hardware, boxed on the host.
     pub struct Detectors;
     /// [`otsu::Otsu`].
@@ -308,6 +310,10 @@ crate::detector_registry! {
     Dog(dog) => dog::Dog,
     /// [`auto::Auto`] (ours, not the paper's).
     Auto(auto) => auto::Auto,
+    /// [`auto::learned::AutoV2`]: `auto`'s development successor (issue 16: a learned
+    /// region stage and a confidence; `null` below its threshold). Registered beside
+    /// `auto` for the comparison; `auto` stays v1 until v2 meets the issue's goals.
+    AutoV2(auto_v2) => auto::learned::AutoV2,
 }
 
 impl Method {

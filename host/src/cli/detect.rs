@@ -11,6 +11,7 @@ use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
 use crate::imaging::image_io::{ReadOptions, parse_crop, read_frame_with};
 use tirroi_core::Method;
+use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
 
 /// The options of `tirroi detect`.
@@ -49,6 +50,14 @@ pub struct DetectArgs {
     /// 328x248.
     #[arg(long, value_name = "INSTRUCTIONS")]
     pub budget: Option<u32>,
+    /// `auto-v2` only: its saturated blob's cut, px per side, 0..=8: the reach of the
+    /// camera's optics blur (`AutoV2::saturated_erode_px`). The default, 2, is the
+    /// flight camera's (the Hayabusa2 TIR with its optics PSF: scenes with `[camera]
+    /// optics_psf = true`); 0 for frames without optics blur (the `paper` world, the
+    /// fixtures). `eval` takes it from the dataset's manifest instead.
+    #[arg(long, value_name = "PX", default_value_t = AutoV2::default().saturated_erode_px,
+          value_parser = clap::value_parser!(u8).range(0..=8))]
+    pub saturated_erode_px: u8,
     /// Frames to process (PNG, TIFF or FITS).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -103,6 +112,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
         &args.files,
     );
     let mut bank = DetectorBank::default();
+    bank.set_saturated_erode_px(args.saturated_erode_px);
     if let Some(rule) = args.box_rule {
         bank.set_box_rule(rule);
     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use tirroi_core::BoxRule;
 
 use super::methods::{MethodChoice, method_help, parse_methods};
-use crate::eval::bank::DetectorBank;
+use crate::eval::bank::{self, DetectorBank};
 use crate::eval::confidence_report;
 use crate::eval::predictions::{self, PredictionSet};
 use crate::eval::scoring::{self, EvalError, TruthCoverage, TruthRow};
@@ -174,11 +174,16 @@ pub fn run(args: &EvalArgs) -> Result<(), String> {
     let mut scores = if options.methods.is_empty() {
         Vec::new()
     } else {
+        // `auto-v2`'s saturated cut is the camera's: from the dataset's manifest.
+        let erode_px = bank::saturated_erode_px_of_dataset(images)?;
+        let make_bank = || {
+            let mut bank = DetectorBank::default();
+            bank.set_saturated_erode_px(erode_px);
+            bank
+        };
         let bar = progress::bar(rows.len(), "frames");
-        let s = scoring::score(images, &rows, &options, &DetectorBank::default, &|| {
-            bar.inc(1)
-        })
-        .map_err(|e| e.to_string())?;
+        let s = scoring::score(images, &rows, &options, &make_bank, &|| bar.inc(1))
+            .map_err(|e| e.to_string())?;
         bar.finish_and_clear();
         s
     };

@@ -1,19 +1,25 @@
 //! Running the core's detectors from the host, one reusable scratch per method.
 
+use std::path::Path;
 use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
+use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method, Roi};
 
+use crate::dataset::{MANIFEST_FILE, Manifest};
+use crate::world::scene::SceneFile;
+
 /// Every registered detector (the core's registry, [`Method::ALL`]) with its
 /// parameters and its scratch memory, ready to run frame after frame: the 328×248
-/// bank (boxed: about 141 KB) and, made on the first frame that needs them, the
+/// bank (boxed: about 190 KB) and, made on the first frame that needs them, the
 /// 640×512 and 1024×768 banks; the smallest that holds a frame runs it.
 pub struct DetectorBank {
-    /// The parameters of each method but `auto`, at [`Method::index`].
-    others: [Params; OTHERS],
+    /// The parameters of each method at [`Method::index`]; `auto`'s slot is unused
+    /// (its parameters are [`Self::auto`]).
+    others: [Params; Method::ALL.len()],
     /// `auto`'s parameters, typed: budgeted calls need an [`Auto`] (no other variant of
     /// [`Params`] can stand in its place).
     auto: Auto,
@@ -24,14 +30,6 @@ pub struct DetectorBank {
     auto_budgeted: Option<Box<AutoScratch>>,
 }
 
-/// Methods other than `auto`: the registry puts `auto` last, so they are
-/// `Method::ALL[..OTHERS]` at their own [`Method::index`].
-const OTHERS: usize = Method::ALL.len() - 1;
-const _: () = assert!(
-    Method::Auto.index() == OTHERS,
-    "auto is the registry's last method"
-);
-
 /// True when `frame` fits capacity `C`.
 fn fits<C: FrameCapacity>(frame: &Frame<'_>) -> bool {
     frame.width() <= C::WIDTH && frame.height() <= C::HEIGHT
@@ -41,7 +39,7 @@ impl Default for DetectorBank {
     /// Every detector with its default parameters.
     fn default() -> Self {
         DetectorBank {
-            others: core::array::from_fn(|i| Method::ALL[i].default_params()),
+            others: Method::ALL.map(Method::default_params),
             auto: Auto::default(),
             scratch: Box::new(Detectors::new()),
             scratch_640x512: None,
@@ -54,11 +52,15 @@ impl Default for DetectorBank {
 impl DetectorBank {
     /// The parameters `method` runs with.
     pub fn params(&self, method: Method) -> Params {
-        // Only `auto`'s index (OTHERS) is past the end of `others`.
-        self.others
-            .get(method.index())
-            .copied()
-            .unwrap_or(Params::Auto(self.auto))
+        match method {
+            Method::Auto => Params::Auto(self.auto),
+            // `others` has a slot per method (`Method::index` < `Method::ALL.len()`).
+            other => self
+                .others
+                .get(other.index())
+                .copied()
+                .unwrap_or_else(|| other.default_params()),
+        }
     }
 
     /// Sets the parameters of their method (the other methods keep theirs).
@@ -77,6 +79,15 @@ impl DetectorBank {
     /// frame).
     pub fn set_prior(&mut self, prior: Option<Roi>) {
         self.auto.prior = prior;
+    }
+
+    /// Sets `auto-v2`'s saturated cut (`AutoV2::saturated_erode_px`, px per side): a
+    /// property of the camera, the reach of its optics' blur (2 for a camera with the
+    /// optics PSF, 0 without; [`saturated_erode_px_for_optics`]).
+    pub fn set_saturated_erode_px(&mut self, px: u8) {
+        if let Some(Params::AutoV2(v2)) = self.others.get_mut(Method::AutoV2.index()) {
+            v2.saturated_erode_px = px;
+        }
     }
 
     /// Sets the mask-to-box rule of every detector (`auto` has none).
@@ -134,6 +145,35 @@ impl DetectorBank {
         self.make_room(frame);
         timed_median(repeat, || self.detect(method, frame))
     }
+}
+
+/// `auto-v2`'s saturated cut for a camera with (`true`) or without the optics PSF
+/// (`[camera] optics_psf` of a scene file), px per side: the default
+/// ([`AutoV2::default`], chosen for the flight camera with its optics' blur) with
+/// optics, 0 without (no blur to cut back: the `paper` world, the fixtures).
+pub fn saturated_erode_px_for_optics(optics_psf: bool) -> u8 {
+    if optics_psf {
+        AutoV2::default().saturated_erode_px
+    } else {
+        0
+    }
+}
+
+/// `auto-v2`'s saturated cut for the frames of the dataset directory `dir`, px per
+/// side: [`saturated_erode_px_for_optics`] of its run manifest's (`tirroi-run.json`)
+/// scene `[camera] optics_psf`; 0 when `dir` has no manifest (frames not rendered by
+/// `tirroi render`: the fixtures, the test sets' composites, files from elsewhere).
+///
+/// # Errors
+/// One line naming the manifest when it exists but cannot be read, or its scene
+/// cannot be parsed.
+pub fn saturated_erode_px_of_dataset(dir: &Path) -> Result<u8, String> {
+    let Some(manifest) = Manifest::read(dir).map_err(|e| e.to_string())? else {
+        return Ok(saturated_erode_px_for_optics(false));
+    };
+    let source = dir.join(MANIFEST_FILE).display().to_string();
+    let scene = SceneFile::parse(&manifest.scene, &source).map_err(|e| e.to_string())?;
+    Ok(saturated_erode_px_for_optics(scene.camera.optics_psf))
 }
 
 /// Runs `call` `repeat` times (at least once): its first result and the median wall
@@ -209,7 +249,7 @@ mod tests {
         let want = Auto::default().with_prior(Some(prior));
         assert_eq!(bank.params(Method::Auto), Params::Auto(want));
         // The other methods keep their defaults.
-        for method in &Method::ALL[..OTHERS] {
+        for method in Method::ALL.iter().filter(|m| **m != Method::Auto) {
             assert_eq!(bank.params(*method), method.default_params(), "{method}");
         }
         // A budgeted call runs the bank's `auto` (prior included): same answer as the
@@ -234,5 +274,51 @@ mod tests {
         assert_eq!(report, want_report);
         bank.set_params(Params::Auto(Auto::default()));
         assert_eq!(bank.params(Method::Auto), Method::Auto.default_params());
+    }
+
+    /// `eval`'s saturated cut comes from the dataset's camera: the `realistic` preset
+    /// (optics PSF on) gives the flight default, `paper` (off) and a directory without a
+    /// manifest 0, a broken manifest an error naming it; the bank then runs `auto-v2`
+    /// with it and leaves every other method as it was.
+    #[test]
+    fn saturated_cut_follows_the_manifest_camera() {
+        use crate::dataset::{Outputs, RunSource};
+        let tmp = std::env::temp_dir().join(format!("tirroi-bank-erode-{}", std::process::id()));
+        std::fs::create_dir_all(&tmp).expect("temp dir");
+        let dir = tmp.as_path();
+        assert_eq!(saturated_erode_px_of_dataset(dir), Ok(0));
+        for (preset, optics) in [("realistic", true), ("paper", false)] {
+            let file = SceneFile::preset(preset).expect("built-in preset");
+            assert_eq!(file.camera.optics_psf, optics, "{preset}");
+            let outputs = Outputs {
+                masks: false,
+                preview: false,
+            };
+            Manifest::new(RunSource::Preset(preset.into()), &file, outputs, None)
+                .expect("manifest")
+                .write(dir)
+                .expect("written");
+            let want = if optics {
+                AutoV2::default().saturated_erode_px
+            } else {
+                0
+            };
+            assert_eq!(saturated_erode_px_of_dataset(dir), Ok(want), "{preset}");
+        }
+        assert_eq!(AutoV2::default().saturated_erode_px, 2);
+        std::fs::write(dir.join(MANIFEST_FILE), "{").expect("written");
+        let err = saturated_erode_px_of_dataset(dir).expect_err("broken manifest");
+        assert!(err.contains(MANIFEST_FILE), "{err}");
+        std::fs::remove_dir_all(dir).expect("temp dir removed");
+        let mut bank = DetectorBank::default();
+        bank.set_saturated_erode_px(0);
+        let want = AutoV2 {
+            saturated_erode_px: 0,
+            ..AutoV2::default()
+        };
+        assert_eq!(bank.params(Method::AutoV2), Params::AutoV2(want));
+        for method in Method::ALL.into_iter().filter(|m| *m != Method::AutoV2) {
+            assert_eq!(bank.params(method), method.default_params(), "{method}");
+        }
     }
 }

@@ -10,14 +10,15 @@ use crate::imaging::image_io::{FrameBuf, FrameFileError};
 /// Colour of the truth box.
 pub const TRUTH_COLOUR: [u8; 3] = [0, 220, 0];
 /// Colours of the detectors' boxes, in registry order (`Method::ALL`: otsu, adaptive,
-/// WGE, DoG, auto); a detector beyond them takes them again from the start
+/// WGE, DoG, auto, auto-v2); a detector beyond them takes them again from the start
 /// ([`method_colour`]).
-pub const METHOD_COLOURS: [[u8; 3]; 5] = [
+pub const METHOD_COLOURS: [[u8; 3]; 6] = [
     [255, 60, 60],
     [60, 140, 255],
     [255, 200, 0],
     [220, 0, 220],
     [0, 230, 230],
+    [255, 130, 0],
 ];
 
 /// The box colour of `method` ([`METHOD_COLOURS`] at its registry position).

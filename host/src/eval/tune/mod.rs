@@ -27,8 +27,8 @@
 //!
 //! | auto | `coarse_sigma` × `fine_sigma` (noise units; no box rule) | {6, 8, 10, 12, 16} × {6, 8, 12, 16} |
 //!
-//! That is 2 + 126 + 144 + 96 (+ 12 for auto) grid sets; the refinement adds some 20–150 trials per
-//! method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
+//! That is 2 + 126 + 144 + 96 (+ 20 for auto, 1 for auto-v2: its defaults, no grid)
+//! grid sets; the refinement adds some 20–150 trials per method. Refinement ladders are the `*_LADDER` constants. Frames are scored through
 //! [`crate::eval::scoring::score`] (in parallel, one run each); while the grids run, each pass over
 //! the frames scores one grid set of every method, so a frame is decoded once per pass
 //! rather than once per set. Measured (release, 2 cores shared with other work): four

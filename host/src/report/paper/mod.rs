@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use tirroi_core::Method;
 
 use crate::dataset::{self, WriteOptions};
+use crate::eval::bank::saturated_erode_px_of_dataset;
 use crate::eval::scoring::{self, EvalOptions, FrameScore, TruthRow};
 use crate::eval::split;
 use crate::eval::tuned::{TunedFor, tuned_bank};
@@ -200,10 +201,15 @@ fn score(
         fits_offset_dn: None,
         crop: None,
     };
-    let scores = scoring::score(dir, rows, &eval_options, &|| tuned_bank(kind), &|| {
-        bar.inc(1)
-    })
-    .map_err(|e| e.to_string())?;
+    // `auto-v2`'s saturated cut is the camera's: from the dataset's manifest.
+    let erode_px = saturated_erode_px_of_dataset(dir)?;
+    let make_bank = || {
+        let mut bank = tuned_bank(kind);
+        bank.set_saturated_erode_px(erode_px);
+        bank
+    };
+    let scores = scoring::score(dir, rows, &eval_options, &make_bank, &|| bar.inc(1))
+        .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     Ok(scores)
 }

@@ -55,6 +55,14 @@ pub fn fill_cells(
             for (cx, (s, st)) in sums.iter_mut().zip(step_row.iter_mut()).enumerate() {
                 let xa = x0 + cx * CELL_PX;
                 let xb = (xa + CELL_PX).min(x0 + w);
+                // An inner cell (a pixel on each side, both neighbouring rows): the same
+                // sums and steps from slices, without a bounds check per read.
+                if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
+                    let (acc, best) = inner_cell(row, u, d, xa, xb, max_dn, *st);
+                    *s += acc;
+                    *st = best;
+                    continue;
+                }
                 let mut acc = 0u32;
                 let mut best = *st;
                 for x in xa..xb {
@@ -99,6 +107,41 @@ pub fn fill_cells(
             *m = (s / (rows * cols).max(1)) as u16;
         }
     }
+}
+
+/// The sum of pixels `xa..xb` of `row` (clamped to `max_dn`) and the largest of `best`
+/// and their two-pixel steps, across (`row[x − 1]` to `row[x + 1]`) and down (`up[x]` to
+/// `down[x]`), for `1 ≤ xa` and `xb < row.len()` (an inner cell: every neighbour in the
+/// row); `fill_cells`'s per-pixel loop without its edge clamps. Slices out of range (never,
+/// by the caller's test) give `(0, best)`.
+#[inline(always)]
+fn inner_cell(
+    row: &[u16],
+    up: &[u16],
+    down: &[u16],
+    xa: usize,
+    xb: usize,
+    max_dn: u16,
+    best: u16,
+) -> (u32, u16) {
+    let (Some(left), Some(mid), Some(right), Some(up), Some(down)) = (
+        row.get(xa.wrapping_sub(1)..xb.wrapping_sub(1)),
+        row.get(xa..xb),
+        row.get(xa + 1..xb + 1),
+        up.get(xa..xb),
+        down.get(xa..xb),
+    ) else {
+        return (0, best);
+    };
+    let mut acc = 0u32;
+    let mut best = best;
+    for ((((&l, &v), &r), &u), &d) in left.iter().zip(mid).zip(right).zip(up).zip(down) {
+        acc += u32::from(v.min(max_dn));
+        let h = l.min(max_dn).abs_diff(r.min(max_dn));
+        let vert = u.min(max_dn).abs_diff(d.min(max_dn));
+        best = best.max(h).max(vert);
+    }
+    (acc, best)
 }
 
 /// Side of the finer windows the classifier also looks through, pixels: a 3–12 px far
@@ -177,4 +220,78 @@ pub fn sub_window_extremes(frame: &Frame<'_>, win: Window, (cx, cy): (usize, usi
         hot.unwrap_or(mean).min(u32::from(max_dn)) as u16,
         cold.unwrap_or(mean).min(u32::from(max_dn)) as u16,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    /// The cell plane against a brute force over the pixels (sum and the largest
+    /// clamped two-pixel step across and down, neighbours clamped at the frame's edges)
+    /// on frames of odd sizes (partial cells on the right and bottom), values above the
+    /// bit depth's top DN, and the full reference size.
+    #[test]
+    fn cell_plane_equals_brute_force() {
+        let mut seed = 0x2545_F491u32;
+        for (w, h, bits) in [
+            (37usize, 29usize, 12u8),
+            (328, 248, 14),
+            (9, 1, 14),
+            (1, 9, 8),
+        ] {
+            let px: Vec<u16> = (0..w * h)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 17;
+                    seed ^= seed << 5;
+                    (seed % 20_000) as u16
+                })
+                .collect();
+            let frame = Frame::new(&px, w, h, bits).unwrap();
+            let win = Window::full(&frame);
+            let (pw, ph) = cell_plane(win);
+            let sigma = 7u32;
+            let (mut mean, mut code) = (std::vec![0u16; pw * ph], std::vec![0u8; pw * ph]);
+            let (mut sums, mut steps) = (std::vec![0u32; pw], std::vec![0u16; pw]);
+            fill_cells(
+                &frame,
+                win,
+                sigma,
+                CellPlanes {
+                    mean_dn: &mut mean,
+                    step_code: &mut code,
+                },
+                &mut sums,
+                &mut steps,
+            );
+            let top = frame.max_dn();
+            let at = |x: usize, y: usize| px[y * w + x].min(top);
+            for cy in 0..ph {
+                for cx in 0..pw {
+                    let (mut s, mut n, mut best) = (0u64, 0u64, 0u16);
+                    for y in cy * 8..(cy * 8 + 8).min(h) {
+                        for x in cx * 8..(cx * 8 + 8).min(w) {
+                            s += u64::from(at(x, y));
+                            n += 1;
+                            let across =
+                                at(x.saturating_sub(1), y).abs_diff(at((x + 1).min(w - 1), y));
+                            let down =
+                                at(x, y.saturating_sub(1)).abs_diff(at(x, (y + 1).min(h - 1)));
+                            best = best.max(across).max(down);
+                        }
+                    }
+                    let i = cy * pw + cx;
+                    assert_eq!(u64::from(mean[i]), s / n, "{w}x{h} cell ({cx}, {cy})");
+                    let want = super::super::features::log_code(u32::from(best) * 4 / sigma);
+                    assert_eq!(
+                        i32::from(code[i]),
+                        want.clamp(0, 255),
+                        "{w}x{h} ({cx}, {cy})"
+                    );
+                }
+            }
+        }
+    }
 }

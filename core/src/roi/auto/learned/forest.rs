@@ -5,6 +5,7 @@
 //! cell is mostly target, times [`SCORE_ONE`].
 
 use super::features::FEATURES;
+use super::forest_trees;
 
 /// Score units per unit of log-odds (fixed point).
 pub const SCORE_ONE: i32 = 256;
@@ -48,4 +49,248 @@ pub fn score(nodes: &[Node], roots: &[u16], bias: i32, f: &[i32; FEATURES]) -> i
         }
     }
     s
+}
+
+/// Deepest tree of a forest table (splits on the longest root-to-leaf path; 0 for a
+/// tree that is one leaf), evaluated at compile time by [`FlatForest::build`].
+/// Panics (a compile error, in a `const`) on a malformed table: a child index out of
+/// range or a path longer than `MAX_DEPTH`.
+pub const fn max_depth(nodes: &[Node], roots: &[u16]) -> usize {
+    let mut deepest = 0;
+    let mut t = 0;
+    while t < roots.len() {
+        // Depth-first over the tree with an explicit stack of (node, depth).
+        let mut stack = [(0u16, 0usize); 2 * MAX_DEPTH + 2];
+        let mut top = 1;
+        stack[0] = (roots[t], 0);
+        while top > 0 {
+            top -= 1;
+            let (i, d) = stack[top];
+            let n = &nodes[i as usize];
+            if n.feature == LEAF {
+                if d > deepest {
+                    deepest = d;
+                }
+                continue;
+            }
+            assert!(d < MAX_DEPTH, "a tree deeper than MAX_DEPTH");
+            assert!((n.feature as usize) < FEATURES, "a split on no feature");
+            stack[top] = (n.left, d + 1);
+            stack[top + 1] = (n.right, d + 1);
+            top += 2;
+        }
+        t += 1;
+    }
+    deepest
+}
+
+/// Feature slots of the flat form's per-cell copy: a power of two at least
+/// [`FEATURES`], so a feature index masked by `FEATURE_SLOTS − 1` needs no bounds check.
+const FEATURE_SLOTS: usize = FEATURES.next_power_of_two();
+const _: () = assert!(FEATURES <= FEATURE_SLOTS);
+
+/// A forest laid out for branch-light evaluation, derived at compile time from a node
+/// table ([`FlatForest::build`]): each of the `T` trees as a complete binary tree of
+/// depth `D = log2 L` in heap order (children of split `k`: `2k + 1`, `2k + 2`; `L − 1`
+/// splits, then `L` leaves). A leaf of the table above depth `D` becomes splits that
+/// always go left (threshold `i32::MAX`) down to a leaf holding its value, so every
+/// cell walks exactly `D` splits per tree: no leaf test, no data-dependent loop length,
+/// and every index is masked by `L − 1` (no bounds check). Scores equal [`score`]'s over
+/// the same table, bit for bit (the same comparisons, the same saturating sum in the
+/// same tree order; tested on both sides of every split of the flight table and on
+/// random features).
+#[derive(Debug, Clone, Copy)]
+pub struct FlatForest<const T: usize, const L: usize> {
+    /// Feature of each split (heap order; slot `L − 1` unused), per tree.
+    pub feature: [[u8; L]; T],
+    /// Threshold of each split (feature ≤ threshold goes left), per tree.
+    pub threshold: [[i32; L]; T],
+    /// Leaf values, score units, per tree.
+    pub leaf: [[i32; L]; T],
+    /// The forest's bias, score units.
+    pub bias: i32,
+}
+
+impl<const T: usize, const L: usize> FlatForest<T, L> {
+    /// Splits per tree.
+    const SPLITS: usize = L - 1;
+    /// Levels per tree.
+    const DEPTH: u32 = L.trailing_zeros();
+
+    /// The flat form of the table (`nodes`, `roots`, `bias`); `L` must be a power of two
+    /// whose log is at least the table's [`max_depth`], and `T` its tree count.
+    /// Evaluated in a `const`: a mismatch is a compile error.
+    pub const fn build(nodes: &[Node], roots: &[u16], bias: i32) -> Self {
+        assert!(roots.len() == T, "T is not the table's tree count");
+        assert!(L.is_power_of_two(), "L a power of two");
+        let s = Self::SPLITS;
+        assert!(
+            max_depth(nodes, roots) <= Self::DEPTH as usize,
+            "L too small for the deepest tree"
+        );
+        let mut out = FlatForest {
+            feature: [[0; L]; T],
+            threshold: [[i32::MAX; L]; T],
+            leaf: [[0; L]; T],
+            bias,
+        };
+        let mut t = 0;
+        while t < T {
+            // Heap position → table node (a table leaf stays in place as it goes left).
+            let mut at = [0u16; 256];
+            assert!(s + L <= 256, "depth at most 7 (256 heap slots)");
+            at[0] = roots[t];
+            let mut k = 0;
+            while k < s + L {
+                let n = &nodes[at[k] as usize];
+                if k < s {
+                    if n.feature == LEAF {
+                        // Always left: any feature ≤ i32::MAX.
+                        out.feature[t][k] = 0;
+                        out.threshold[t][k] = i32::MAX;
+                        at[2 * k + 1] = at[k];
+                        at[2 * k + 2] = at[k];
+                    } else {
+                        out.feature[t][k] = n.feature;
+                        out.threshold[t][k] = n.threshold;
+                        at[2 * k + 1] = n.left;
+                        at[2 * k + 2] = n.right;
+                    }
+                } else {
+                    assert!(n.feature == LEAF, "a split below depth D");
+                    out.leaf[t][k - s] = n.value;
+                }
+                k += 1;
+            }
+            t += 1;
+        }
+        out
+    }
+
+    /// The forest's score of one cell's features: bias + one leaf per tree, as
+    /// [`score`] (the same sum, saturating, in tree order).
+    #[inline]
+    pub fn score(&self, f: &[i32; FEATURES]) -> i32 {
+        let mut slots = [0i32; FEATURE_SLOTS];
+        for (slot, &v) in slots.iter_mut().zip(f) {
+            *slot = v;
+        }
+        let mask = L - 1;
+        let mut s = self.bias;
+        for ((feature, threshold), leaf) in self.feature.iter().zip(&self.threshold).zip(&self.leaf)
+        {
+            let mut k = 0usize;
+            for _ in 0..Self::DEPTH {
+                let fi = usize::from(feature[k & mask]) & (FEATURE_SLOTS - 1);
+                let right = slots[fi] > threshold[k & mask];
+                k = 2 * k + 1 + usize::from(right);
+            }
+            s = s.saturating_add(leaf[k.wrapping_sub(Self::SPLITS) & mask]);
+        }
+        s
+    }
+}
+
+/// Depth of the flight forest (`forest_trees.rs`, generated by `scripts/train-auto.py`),
+/// found at compile time.
+pub const FLIGHT_DEPTH: usize = max_depth(&forest_trees::NODES, &forest_trees::ROOTS);
+
+/// The flight forest's flat form.
+pub type FlightForest = FlatForest<{ forest_trees::ROOTS.len() }, { 1 << FLIGHT_DEPTH }>;
+
+/// The flight forest (`forest_trees.rs`) in its flat form, built at compile time: what
+/// `auto-v2` evaluates per cell (in flash, like the node table it is derived from).
+pub static FLIGHT: FlightForest = FlatForest::build(
+    &forest_trees::NODES,
+    &forest_trees::ROOTS,
+    forest_trees::BIAS,
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The flat form scores as the node table walked node by node: on features at
+    /// every split's threshold and one above it (both sides of every comparison of the
+    /// flight table) and on random features over the features' range.
+    #[test]
+    fn flat_forest_scores_as_the_node_table() {
+        let walk = |f: &[i32; FEATURES]| {
+            score(
+                &forest_trees::NODES,
+                &forest_trees::ROOTS,
+                forest_trees::BIAS,
+                f,
+            )
+        };
+        const { assert!(FLIGHT_DEPTH >= 1 && FLIGHT_DEPTH <= 7) };
+        let mut checked = 0u32;
+        let mut s = 0x9E37_79B9u32;
+        let mut rand = || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s
+        };
+        for n in forest_trees::NODES.iter().filter(|n| n.feature != LEAF) {
+            for v in [n.threshold, n.threshold.saturating_add(1)] {
+                // The split's feature at the threshold or just above; the others random.
+                let mut f = [0i32; FEATURES];
+                for x in f.iter_mut() {
+                    *x = (rand() % 1024) as i32 - 512;
+                }
+                f[usize::from(n.feature)] = v;
+                assert_eq!(FLIGHT.score(&f), walk(&f), "{f:?}");
+                checked += 1;
+            }
+        }
+        for _ in 0..20_000 {
+            let mut f = [0i32; FEATURES];
+            for x in f.iter_mut() {
+                *x = (rand() % 4096) as i32 - 2048;
+            }
+            assert_eq!(FLIGHT.score(&f), walk(&f), "{f:?}");
+            checked += 1;
+        }
+        assert!(checked > 20_000);
+    }
+
+    /// A hand-made table with a leaf above the deepest level: the flat form sends every
+    /// path through it to its value.
+    #[test]
+    fn shallow_leaves_are_carried_down() {
+        let leaf = |value| Node {
+            feature: LEAF,
+            threshold: 0,
+            left: 0,
+            right: 0,
+            value,
+        };
+        let split = |feature, threshold, left, right| Node {
+            feature,
+            threshold,
+            left,
+            right,
+            value: 0,
+        };
+        // Tree 0: f0 ≤ 10 → leaf 5, else (f1 ≤ 0 → leaf −3, else leaf 7). Tree 1: leaf 100.
+        let nodes = [
+            split(0, 10, 1, 2),
+            leaf(5),
+            split(1, 0, 3, 4),
+            leaf(-3),
+            leaf(7),
+            leaf(100),
+        ];
+        let roots = [0u16, 5];
+        assert_eq!(max_depth(&nodes, &roots), 2);
+        let flat = FlatForest::<2, 4>::build(&nodes, &roots, -1);
+        for (f0, f1, want) in [(10, 99, 104), (11, 0, 96), (11, 1, 106), (-50, -50, 104)] {
+            let mut f = [0i32; FEATURES];
+            f[0] = f0;
+            f[1] = f1;
+            assert_eq!(flat.score(&f), want, "{f0} {f1}");
+            assert_eq!(score(&nodes, &roots, -1, &f), want, "{f0} {f1}");
+        }
+    }
 }

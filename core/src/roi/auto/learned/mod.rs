@@ -345,12 +345,9 @@ impl AutoV2 {
         // above the cell threshold, in quarter units of log-odds), 0 otherwise.
         let cell_score = i32::from(self.cell_score);
         let (plane8, lv) = cell_pass(frame, work, |_, _, feats| {
-            let s = forest::score(
-                &forest_trees::NODES,
-                &forest_trees::ROOTS,
-                forest_trees::BIAS,
-                feats,
-            );
+            // The flat form of `forest_trees.rs` (built at compile time; the same
+            // score as walking its nodes, `forest::score`).
+            let s = forest::FLIGHT.score(feats);
             let above = s - cell_score;
             if above >= 0 {
                 (1 + above / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8

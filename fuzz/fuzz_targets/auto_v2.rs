@@ -1,0 +1,66 @@
+//! Fuzz target: `auto-v2` on arbitrary frames and parameters never panics; its box lies
+//! inside the frame; its confidence is in 0..=1000 ‰, at least the threshold for a box
+//! and 0 for `null`; a threshold just above the box's confidence gives `null`; and the
+//! same frame gives the same answer twice.
+//!
+//! Input layout: byte 0 width − 1 (mod 328), byte 1 height − 1 (mod 248), byte 2 bit
+//! depth − 1 (mod 16), byte 3 `fine_sigma` − 1 (mod 40), bytes 4..6 `cell_score`
+//! (little-endian i16, mod 8193 − 4096), bytes 6..8 `min_score_permille` (little-endian
+//! u16, mod 1001), byte 8 `saturated_erode_px` (mod 9), the rest the DN (little-endian
+//! u16, repeated to fill the frame; none: a black frame).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+use tirroi_core::{Detector, Frame, SCORE_FULL_PERMILLE};
+
+fuzz_target!(|data: &[u8]| {
+    if data.len() < 9 {
+        return;
+    }
+    let w = 1 + usize::from(data[0]) % 328;
+    let h = 1 + usize::from(data[1]) % 248;
+    let bits = 1 + data[2] % 16;
+    let det = AutoV2 {
+        fine_sigma: 1 + u16::from(data[3] % 40),
+        cell_score: (i32::from(i16::from_le_bytes([data[4], data[5]])).rem_euclid(8193) - 4096)
+            as i16,
+        min_score_permille: u16::from_le_bytes([data[6], data[7]]) % 1001,
+        saturated_erode_px: data[8] % 9,
+    };
+    let dn: Vec<u16> = data[9..]
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect();
+    let pixels: Vec<u16> = (0..w * h)
+        .map(|i| if dn.is_empty() { 0 } else { dn[i % dn.len()] })
+        .collect();
+    let frame = Frame::new(&pixels, w, h, bits).expect("valid dimensions");
+    let mut scratch = Box::new(AutoV2Scratch::new());
+    let d = det.detect(&frame, &mut scratch).expect("valid parameters");
+    assert!(d.score_permille <= SCORE_FULL_PERMILLE, "{d:?}");
+    match d.roi {
+        Some(r) => {
+            assert!(!r.is_empty(), "{r:?}");
+            assert!(
+                usize::from(r.x1) <= w && usize::from(r.y1) <= h,
+                "{r:?} in {w}x{h}"
+            );
+            assert!(d.score_permille >= det.min_score_permille, "{d:?}");
+            if d.score_permille < SCORE_FULL_PERMILLE {
+                // A threshold just above the confidence: no target.
+                let stricter = AutoV2 {
+                    min_score_permille: d.score_permille + 1,
+                    ..det
+                };
+                let n = stricter
+                    .detect(&frame, &mut scratch)
+                    .expect("valid parameters");
+                assert_eq!((n.roi, n.score_permille), (None, 0), "{d:?}");
+            }
+        }
+        None => assert_eq!(d.score_permille, 0, "{d:?}"),
+    }
+    // The same frame again in the same scratch gives the same detection.
+    assert_eq!(det.detect(&frame, &mut scratch).unwrap(), d);
+});
