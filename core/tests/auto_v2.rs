@@ -18,6 +18,7 @@ use common::*;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
+use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, SCORE_FULL_PERMILLE};
@@ -38,17 +39,34 @@ fn params() -> impl Strategy<Value = AutoV2> {
     (
         prop_oneof![Just(8u16), 1u16..=1000],
         prop_oneof![Just(0i16), -4096i16..=4096],
-        prop_oneof![Just(650u16), Just(0u16), 0u16..=1000],
+        prop_oneof![Just(550u16), Just(0u16), 0u16..=1000],
         0u8..=8,
+        body_params(),
     )
         .prop_map(
-            |(fine_sigma, cell_score, min_score_permille, saturated_erode_px)| AutoV2 {
+            |(fine_sigma, cell_score, min_score_permille, saturated_erode_px, body)| AutoV2 {
                 fine_sigma,
                 cell_score,
                 min_score_permille,
                 saturated_erode_px,
+                body,
             },
         )
+}
+
+/// The body stage's parameters within their documented bounds (`BodyParams::is_valid`),
+/// the default and the stage switched off weighted in.
+fn body_params() -> impl Strategy<Value = BodyParams> {
+    let any = (0u16..=100, 1u8..=8, 0u8..=16, 1u16..=1000, 0u16..=1000).prop_map(
+        |(k_sigma, ring_from_cells, extra, max_share_permille, trim_permille)| BodyParams {
+            k_sigma,
+            ring_from_cells,
+            ring_to_cells: (ring_from_cells + extra).min(16),
+            max_share_permille,
+            trim_permille,
+        },
+    );
+    prop_oneof![Just(BodyParams::DEFAULT), Just(BodyParams::OFF), any]
 }
 
 /// A frame of `w × h` from `seed`: the shared generators (noise in and out of range,

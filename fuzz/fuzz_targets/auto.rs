@@ -39,7 +39,10 @@ fuzz_target!(|data: &[u8]| {
     let d = auto.detect(&frame, &mut scratch).expect("valid parameters");
     if let Some(r) = d.roi {
         assert!(!r.is_empty(), "{r:?}");
-        assert!(usize::from(r.x1) <= w && usize::from(r.y1) <= h, "{r:?} in {w}x{h}");
+        assert!(
+            usize::from(r.x1) <= w && usize::from(r.y1) <= h,
+            "{r:?} in {w}x{h}"
+        );
     }
     // The same frame again in the same scratch gives the same detection.
     assert_eq!(auto.detect(&frame, &mut scratch).unwrap(), d);

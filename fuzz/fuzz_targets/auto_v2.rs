@@ -6,11 +6,13 @@
 //! Input layout: byte 0 width − 1 (mod 328), byte 1 height − 1 (mod 248), byte 2 bit
 //! depth − 1 (mod 16), byte 3 `fine_sigma` − 1 (mod 40), bytes 4..6 `cell_score`
 //! (little-endian i16, mod 8193 − 4096), bytes 6..8 `min_score_permille` (little-endian
-//! u16, mod 1001), byte 8 `saturated_erode_px` (mod 9), the rest the DN (little-endian
+//! u16, mod 1001), byte 8 `saturated_erode_px` (mod 9) and, by its top bit, the body
+//! stage on (`BodyParams::DEFAULT`) or off, the rest the DN (little-endian
 //! u16, repeated to fill the frame; none: a black frame).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
 use tirroi_core::{Detector, Frame, SCORE_FULL_PERMILLE};
 
@@ -27,6 +29,11 @@ fuzz_target!(|data: &[u8]| {
             as i16,
         min_score_permille: u16::from_le_bytes([data[6], data[7]]) % 1001,
         saturated_erode_px: data[8] % 9,
+        body: if data[8] & 0x80 == 0 {
+            BodyParams::DEFAULT
+        } else {
+            BodyParams::OFF
+        },
     };
     let dn: Vec<u16> = data[9..]
         .chunks_exact(2)
