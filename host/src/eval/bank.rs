@@ -30,6 +30,17 @@ pub struct DetectorBank {
     auto_budgeted: Option<Box<AutoScratch>>,
 }
 
+/// A fresh bank of capacity `C` on the heap. Never inlined, and called only when a
+/// frame needs the bank: the by-value bank it builds before boxing (about 0.57 MB at
+/// 640×512, 1.25 MB at 1024×768) then lives in this function's stack frame, once,
+/// instead of in the frame of every [`DetectorBank::detect`] call, where both together
+/// overflowed the 2 MiB stack of a rayon worker even for 328×248 frames.
+#[inline(never)]
+#[cold]
+fn new_bank<C: FrameCapacity>() -> Box<Detectors<C>> {
+    Box::new(Detectors::for_capacity())
+}
+
 /// True when `frame` fits capacity `C`.
 fn fits<C: FrameCapacity>(frame: &Frame<'_>) -> bool {
     frame.width() <= C::WIDTH && frame.height() <= C::HEIGHT
@@ -108,12 +119,12 @@ impl DetectorBank {
             self.scratch.detect(params, frame)
         } else if fits::<Cap640x512>(frame) {
             self.scratch_640x512
-                .get_or_insert_with(Box::default)
+                .get_or_insert_with(new_bank)
                 .detect(params, frame)
         } else {
             // Above 1024×768 the core answers `DetectError::FrameTooLarge`.
             self.scratch_1024x768
-                .get_or_insert_with(Box::default)
+                .get_or_insert_with(new_bank)
                 .detect(params, frame)
         }
     }
@@ -125,9 +136,9 @@ impl DetectorBank {
             return;
         }
         if fits::<Cap640x512>(frame) {
-            self.scratch_640x512.get_or_insert_with(Box::default);
+            self.scratch_640x512.get_or_insert_with(new_bank);
         } else {
-            self.scratch_1024x768.get_or_insert_with(Box::default);
+            self.scratch_1024x768.get_or_insert_with(new_bank);
         }
     }
 
@@ -236,6 +247,32 @@ pub fn median(values: &mut [f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every method runs on a 328×248 frame, and the 640×512 bank is made, inside the
+    /// 2 MiB stack of a rayon worker (rayon's default; `tirroi eval` scores on them).
+    /// With the larger banks built inline, `detect`'s own frame outgrew it in release
+    /// builds once `auto-v2` joined the registry: every `tirroi eval` aborted with a
+    /// stack overflow (a debug build calls `Box::default` out of line, so this test
+    /// guards the contract there; the release binary was checked by hand).
+    #[test]
+    fn detect_runs_in_a_rayon_workers_stack() {
+        const RAYON_DEFAULT_STACK_BYTES: usize = 2 << 20;
+        let worker = std::thread::Builder::new()
+            .stack_size(RAYON_DEFAULT_STACK_BYTES)
+            .spawn(|| {
+                let mut bank = DetectorBank::default();
+                let px: Vec<u16> = (0..328 * 248).map(|i| (i % 97) as u16 * 40).collect();
+                let frame = Frame::new(&px, 328, 248, 14).expect("valid frame");
+                for method in Method::ALL {
+                    bank.detect_timed(method, &frame, 1).expect("runs");
+                }
+                let px: Vec<u16> = vec![100; 640 * 512];
+                let frame = Frame::new(&px, 640, 512, 14).expect("valid frame");
+                bank.detect(Method::Otsu, &frame).expect("runs");
+            })
+            .expect("thread starts");
+        assert!(worker.join().is_ok(), "a detector call overflowed 2 MiB");
+    }
 
     #[test]
     fn params_round_trip_for_every_method_and_budgeted_auto_uses_the_prior() {
