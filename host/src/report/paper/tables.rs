@@ -50,20 +50,22 @@ pub fn table(
             o.frames, o.mean_iou, o.median_iou, o.hit_rate, o.mean_time_ms
         ));
     }
-    // Ours beyond the paper (`auto`): one row per group of the paper's rows.
+    // Ours beyond the paper (`auto`, `auto-v2`): one row per group of the paper's rows.
     let mut values: Vec<&str> = Vec::new();
     for &(_, value, ..) in paper {
         if !values.contains(&value) {
             values.push(value);
         }
     }
-    let method = Method::Auto.name();
-    for value in values {
-        let o = ours(scores, method, key, value, band);
-        s.push_str(&format!(
-            "| {method} | {value} | {} | {:.3} | {:.3} | {:.2} | {:.3} | – | – | – |\n",
-            o.frames, o.mean_iou, o.median_iou, o.hit_rate, o.mean_time_ms
-        ));
+    for m in Method::ALL.iter().filter(|m| !Method::PAPER.contains(m)) {
+        let method = m.name();
+        for &value in &values {
+            let o = ours(scores, method, key, value, band);
+            s.push_str(&format!(
+                "| {method} | {value} | {} | {:.3} | {:.3} | {:.2} | {:.3} | – | – | – |\n",
+                o.frames, o.mean_iou, o.median_iou, o.hit_rate, o.mean_time_ms
+            ));
+        }
     }
     s
 }
