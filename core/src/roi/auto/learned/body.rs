@@ -26,6 +26,7 @@
 //! counting passes over the ring, no sort, no copy).
 
 use super::cells::CELL_PX;
+use super::order::select;
 use crate::frame::Frame;
 use crate::roi::Roi;
 
@@ -129,21 +130,6 @@ fn distance(b: CellBox, x: usize, y: usize) -> usize {
     let dx = b.x0.saturating_sub(x).max(x.saturating_sub(b.x1));
     let dy = b.y0.saturating_sub(y).max(y.saturating_sub(b.y1));
     dx.max(dy)
-}
-
-/// The smallest `v` in `0..=hi` with more than `k` of `values()` at most `v` (the
-/// element of index `k` of the sorted values), by bisection: no sort, no copy.
-fn select<I: Iterator<Item = u32>>(values: impl Fn() -> I, k: usize, hi: u32) -> u32 {
-    let (mut lo, mut hi) = (0u32, hi);
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if values().filter(|&v| v <= mid).count() > k {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    lo
 }
 
 /// The background model: the median cell mean of the ring and its spread (the larger
@@ -339,19 +325,6 @@ mod tests {
             s ^= s >> 17;
             s ^= s << 5;
             s
-        }
-    }
-
-    #[test]
-    fn select_equals_a_sort() {
-        let mut r = rng(3);
-        for n in [1usize, 2, 7, 100, 257] {
-            let vals: Vec<u32> = (0..n).map(|_| r() % 70_000 % 65_536).collect();
-            let mut sorted = vals.clone();
-            sorted.sort_unstable();
-            for k in [0, n / 2, n - 1] {
-                assert_eq!(select(|| vals.iter().copied(), k, 65_535), sorted[k]);
-            }
         }
     }
 

@@ -7,6 +7,7 @@
 //! small box is cut to the pixels whose departure from the local background reaches
 //! half the peak departure (same sign as the peak).
 
+use super::order::select;
 use crate::frame::Frame;
 use crate::roi::Roi;
 
@@ -60,16 +61,14 @@ fn ring_median(frame: &Frame<'_>, roi: Roi) -> Option<u16> {
             }
         }
     }
-    let ring = buf.get(..n)?;
-    // The element at index n/2 of the sorted ring, by counting (at most ~100 values,
-    // once per detection): core's sort keeps a panic path (its order-violation check)
-    // the optimiser cannot remove, which the panic-never check would flag.
-    let k = n / 2;
-    ring.iter().copied().find(|&v| {
-        let below = ring.iter().filter(|&&u| u < v).count();
-        let not_above = ring.iter().filter(|&&u| u <= v).count();
-        below <= k && k < not_above
-    })
+    let ring = buf.get(..n).filter(|r| !r.is_empty())?;
+    // The element at index n/2 of the sorted ring.
+    let median = select(
+        || ring.iter().map(|&v| u32::from(v)),
+        n / 2,
+        u32::from(u16::MAX),
+    );
+    u16::try_from(median).ok()
 }
 
 /// `roi` cut to its half maximum (see the module): boxes larger than

@@ -26,6 +26,7 @@ pub mod features;
 pub mod forest;
 mod forest_trees;
 pub mod half_max;
+pub mod order;
 pub mod saturated;
 pub mod shape;
 
