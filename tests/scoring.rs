@@ -137,11 +137,12 @@ fn no_target_frames_boxes_and_signal_to_clutter() {
     let (h, rows) = csv(&ds.join("truth.csv"));
     let meta = metadata(&ds);
     assert_eq!(rows.len(), 8);
-    let (target, x0, x0q, scr) = (
+    let (target, x0, x0q, scr, vis) = (
         col(&h, "target"),
         col(&h, "x0"),
         col(&h, "x0_quarter"),
         col(&h, "signal_to_clutter"),
+        col(&h, "visible_share"),
     );
     // ⌈0.5 × 4⌉ = 2 of the space kind, ⌈0.25 × 4⌉ = 1 of the Earth kind.
     let none: Vec<usize> = (0..8).filter(|&i| rows[i][target] == "none").collect();
@@ -168,6 +169,7 @@ fn no_target_frames_boxes_and_signal_to_clutter() {
             assert_eq!((half, quarter), (None, None));
             assert!(!annotated.contains(&(i as u64 + 1)));
             assert!(row[scr].is_empty() && m["signal_to_clutter"].is_null());
+            assert!(row[vis].is_empty() && m["visible_share"].is_null());
             assert_eq!(m["target"], "none");
             continue;
         }
@@ -192,9 +194,26 @@ fn no_target_frames_boxes_and_signal_to_clutter() {
         let floor = clutter.max(noise).max(1.0 / 12f64.sqrt());
         // (The noise σ is an f32 written in its shortest decimal form.)
         assert!((ratio - contrast / floor).abs() <= 1e-6 * ratio.max(1.0));
+        // The visible box: inside the truth box, its share the area ratio.
+        let v: Vec<u16> = m["visible_bbox"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_u64().unwrap() as u16)
+            .collect();
+        let share = m["visible_share"].as_f64().unwrap();
+        let area = |b: &[u16]| f64::from(b[2] - b[0]) * f64::from(b[3] - b[1]);
+        if v[2] > v[0] {
+            assert!(v[0] >= h2[0] && v[1] >= h2[1] && v[2] <= h2[2] && v[3] <= h2[3]);
+        }
+        assert!((share - area(&v) / area(&h2)).abs() < 1e-12, "{}", row[0]);
+        assert_eq!(row[vis], format!("{share:.4}"));
         if i < 4 {
-            // Deep space, noise-free: nothing behind the target.
+            // Deep space, noise-free: nothing behind the target; a detection-mode
+            // target at 60 m lifts every pixel it half covers far above the 3 × 1/√12
+            // DN threshold, so all of it is visible.
             assert_eq!((clutter, noise), (0.0, 0.0));
+            assert_eq!(v, h2.to_vec(), "{}", row[0]);
         } else {
             // The Earth behind: a background that varies.
             assert!(clutter > 0.0, "{}", row[0]);
@@ -218,7 +237,14 @@ fn no_target_frames_boxes_and_signal_to_clutter() {
         assert_eq!(b.signal_to_clutter, want);
         let csv_value = a.signal_to_clutter.map(|v| format!("{v:.4}"));
         assert_eq!(csv_value, want.map(|v| format!("{v:.4}")));
-        assert_eq!(a.groups, b.groups);
+        // The bare file has no `visible_share` column, so no `visible` group.
+        let bare_groups: Vec<_> = a.groups.iter().filter(|(k, _)| k != "visible").collect();
+        assert_eq!(bare_groups, b.groups.iter().collect::<Vec<_>>());
+        assert_eq!(
+            a.groups.iter().any(|(k, _)| k == "visible"),
+            a.has_target(),
+            "the visible bin for every frame with a target"
+        );
     }
 }
 

@@ -114,9 +114,9 @@ class Frame:
             the target, 0..1.
         metadata: the frame's ``metadata.jsonl`` object: ``target`` ("none" without
             one), ``range_m`` (m), ``earth_fraction`` (0..1), ``noise_sigma_dn`` (DN),
-            ``signal_to_clutter``, ``readout``, ``dn_gain`` (DN per W m^-2),
-            ``dn_offset`` (DN), ``target_temperature_k`` (K), ``mode``, ``scale``,
-            ``illumination``, pose and seeds.
+            ``signal_to_clutter``, ``visible_share`` (0..1), ``readout``,
+            ``dn_gain`` (DN per W m^-2), ``dn_offset`` (DN), ``target_temperature_k``
+            (K), ``mode``, ``scale``, ``illumination``, pose and seeds.
     """
 
     index: int

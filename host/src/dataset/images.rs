@@ -79,6 +79,16 @@ pub struct ImageRecord {
     /// Contrast / max(clutter σ, noise σ, 1/√12 DN) (`None` as above).
     #[serde(default)]
     pub signal_to_clutter: Option<f64>,
+    /// Tight box `[x0, y0, x1, y1]` of the target pixels whose noise-free contrast
+    /// against the background, as the camera sees both, is ≥ 3 noise σ (all 0 when none
+    /// is, or no target); inside `bbox`. `imaging::render::clutter`.
+    #[serde(default)]
+    pub visible_bbox: [u16; 4],
+    /// Area of `visible_bbox` / area of `bbox`, 0..=1: the IoU of a detector that boxes
+    /// exactly the pixels the target changes beyond the noise (an optimistic ceiling;
+    /// `None` as above).
+    #[serde(default)]
+    pub visible_share: Option<f64>,
     /// Noise seed.
     pub noise_seed: Option<u64>,
     /// Bit depth of the DN map (scene `bits`, else the camera's): the PNG is 16-bit,
@@ -203,6 +213,11 @@ pub(super) fn record(
         target_contrast_dn: frame.clutter.map(|c| c.target_contrast_dn),
         clutter_sigma_dn: frame.clutter.map(|c| c.clutter_sigma_dn),
         signal_to_clutter: frame.clutter.map(|c| c.signal_to_clutter),
+        visible_bbox: frame.clutter.map_or([0; 4], |c| {
+            let v = c.visible;
+            [v.x0, v.y0, v.x1, v.y1]
+        }),
+        visible_share: frame.clutter.map(|c| c.visible_share(frame.truth)),
         noise_seed: plan.noise_seed,
         bits: frame.mapping.bits(),
         readout: match (plan.scale, plan.readout) {

@@ -9,9 +9,9 @@ use super::images::{ImageRecord, atomic_write};
 use crate::world::scene::SceneFile;
 
 /// The header line of `truth.csv` (with its newline): the box, the group and metadata
-/// columns, the quarter-coverage box and the signal-to-clutter ratio
-/// ([`crate::dataset`] module docs). Test sets ([`crate::dataset::testset`]) write the same.
-pub const TRUTH_CSV_HEADER: &str = "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter\n";
+/// columns, the quarter-coverage box, the signal-to-clutter ratio and the target's
+/// visible share ([`crate::dataset`] module docs). Test sets ([`crate::dataset::testset`]) write the same.
+pub const TRUTH_CSV_HEADER: &str = "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter,visible_share\n";
 
 /// Writes `truth.csv`, `coco.json` and `metadata.jsonl` (each atomically).
 pub(super) fn write_labels<'a>(
@@ -34,7 +34,7 @@ pub(super) fn write_labels<'a>(
     for r in records {
         let [x0, y0, x1, y1] = r.bbox;
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{}\n",
             r.file,
             boxed(r.bbox),
             r.mode,
@@ -49,6 +49,7 @@ pub(super) fn write_labels<'a>(
             boxed(r.bbox_quarter),
             r.signal_to_clutter
                 .map_or(String::new(), |s| format!("{s:.4}")),
+            r.visible_share.map_or(String::new(), |s| format!("{s:.4}")),
         ));
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');

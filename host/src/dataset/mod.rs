@@ -6,12 +6,14 @@
 //! - `truth.csv`: `file,x0,y0,x1,y1` then metadata columns (the box: (x0, y0)
 //!   inclusive, (x1, y1) exclusive, the tight box of the pixels whose target coverage
 //!   is ≥ `[dataset] truth_coverage`, ½ by default; four empty fields when there is no
-//!   target), then `x0_quarter..y1_quarter` (coverage > ¼) and `signal_to_clutter`;
+//!   target), then `x0_quarter..y1_quarter` (coverage > ¼), `signal_to_clutter` and
+//!   `visible_share` (`imaging::render::clutter`);
 //! - `coco.json`: COCO detection labels (one category, `spacecraft`; no annotation for
 //!   a frame without a target);
 //! - `metadata.jsonl`: one JSON object per image (pose, mode, scale, material,
 //!   illumination, Earth fraction, seeds, DN map, noise σ, target temperatures, both
-//!   boxes, the signal-to-clutter ratio and its parts; [`ImageRecord`]);
+//!   boxes, the signal-to-clutter ratio and its parts, the visible box and share;
+//!   [`ImageRecord`]);
 //! - `masks/NNNNNN.png` (optional): 8-bit target coverage, 255 = fully covered;
 //! - `preview/NNNNNN.png` (optional): contrast-stretched 8-bit RGB with the truth box.
 //!

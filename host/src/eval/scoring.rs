@@ -7,8 +7,9 @@
 //! convention, `docs/architecture.md`: x0, y0 inclusive, x1, y1 exclusive); extra
 //! columns become group labels when they are one of `mode`, `scale`, `target`,
 //! `material`, `illumination`, `range_m` gives the range band (close ≤ 50 m, far
-//! ≥ 300 m, else mid) and `signal_to_clutter` the SCR bin ([`scr_bin`]; without that
-//! column, from the `metadata.jsonl` beside `truth.csv` when there is one). Timing is the
+//! ≥ 300 m, else mid), `signal_to_clutter` the SCR bin ([`scr_bin`]; without that
+//! column, from the `metadata.jsonl` beside `truth.csv` when there is one) and
+//! `visible_share` the visible bin ([`visible_bin`]). Timing is the
 //! core call alone on one thread, the median of `repeat` runs; images are scored in
 //! parallel.
 //!
@@ -124,6 +125,23 @@ pub fn scr_bin(scr: f64) -> &'static str {
         "3-10"
     } else {
         ">=10"
+    }
+}
+
+/// The visible-share bins eval reports (`truth.csv`'s `visible_share`: the truth box's
+/// share a detector can see at all, `imaging::render::clutter`), upper bounds
+/// exclusive: `<0.5` (even the ideal box of the visible pixels is no hit), `0.5-0.9`,
+/// `>=0.9` (the ideal box reaches issue 16's IoU goal of 0.9).
+pub const VISIBLE_BIN_EDGES: [f64; 2] = [0.5, 0.9];
+
+/// The bin label of a visible share ([`VISIBLE_BIN_EDGES`]); the group key is `visible`.
+pub fn visible_bin(share: f64) -> &'static str {
+    if share < VISIBLE_BIN_EDGES[0] {
+        "<0.5"
+    } else if share < VISIBLE_BIN_EDGES[1] {
+        "0.5-0.9"
+    } else {
+        ">=0.9"
     }
 }
 
@@ -301,6 +319,12 @@ pub fn read_truth_lines(
                     if r.is_finite() {
                         groups.push(("scr".into(), scr_bin(r).into()));
                         signal_to_clutter = Some(r);
+                    }
+                }
+            } else if *name == "visible_share" && !roi.is_empty() {
+                if let Ok(v) = value.parse::<f64>() {
+                    if v.is_finite() {
+                        groups.push(("visible".into(), visible_bin(v).into()));
                     }
                 }
             }

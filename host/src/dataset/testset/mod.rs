@@ -358,10 +358,10 @@ pub fn labels(frames: &[TestFrame]) -> Result<(String, String), DatasetError> {
     for f in frames {
         let r = &f.record;
         // file, box, mode, scale, target, material, illumination, range_m,
-        // earth_fraction, noise_seed, bits, quarter box, signal_to_clutter (not
-        // computed for test frames: empty).
+        // earth_fraction, noise_seed, bits, quarter box, signal_to_clutter and
+        // visible_share (not computed for test frames: empty).
         csv.push_str(&format!(
-            "{},{},{},,{},{},{},{},{:.4},{},{},{},\n",
+            "{},{},{},,{},{},{},{},{:.4},{},{},{},,\n",
             r.file,
             boxed(r.bbox),
             r.mode.as_deref().unwrap_or(""),

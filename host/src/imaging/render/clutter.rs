@@ -6,7 +6,14 @@
 //!   is 0 signal). Outside the target's coverage it equals the frame's own noise-free
 //!   signal; under the target it is the Earth (or space) the target hides.
 //! - **Target contrast**, DN: |mean over the target mask (coverage ≥ [`MASK_COVERAGE`])
-//!   of (frame signal − twin signal)| × the frame's DN gain (noise-free, unquantised).
+//!   of (frame signal − twin signal *as the camera sees it*)| × the frame's DN gain
+//!   (noise-free, unquantised). The frame's signal went through the optics PSF and the
+//!   sensor signature, so the twin does too ([`super::through_the_optics`]): their
+//!   difference is the target's own signal, blurred, with the signature's offsets
+//!   (shading, hot pixels) cancelled. (Before session 26 the raw twin was subtracted,
+//!   which left those offsets in the contrast: on `realistic` seed 9001, 77 of 540
+//!   frames were in another SCR bin; without optics and signature, e.g. the `paper`
+//!   world, nothing changes.)
 //! - **Clutter σ**, DN: the standard deviation of the twin over the ring: the pixels
 //!   within [`ring_width_px`] of the truth box (Chebyshev distance, outside the box,
 //!   cut to the frame), × the DN gain.
@@ -14,6 +21,16 @@
 //!   a background flatter than the camera's own noise (deep space, a uniform cloud
 //!   deck) is not what hides the target, and the floor keeps deep space finite; the
 //!   quantisation σ is the floor of a noise-free render.
+//! - **Visible box**: the tight box of the target's pixels (coverage ≥
+//!   [`MASK_COVERAGE`]) whose noise-free signal differs from the background twin *as
+//!   the camera sees it* (twin through the optics PSF and the signature,
+//!   [`super::through_the_optics`]) by at least [`VISIBLE_K_SIGMA`] × max(noise σ,
+//!   [`QUANTISATION_SIGMA_DN`]). A part of the target at its background's level (a cold
+//!   face over deep space, a face at the clouds' temperature) is in the truth box but
+//!   in no pixel of the frame, so `visible_share` = visible box area / truth box area
+//!   (the visible box lies inside the truth box) is the IoU a detector gets that boxes
+//!   every pixel the target changes beyond the noise and nothing else: an optimistic
+//!   ceiling (the clutter, which the detector must also tell apart, is not counted).
 //!
 //! The window's Earth pass supersamples the limb where neighbours *inside the window*
 //! differ, so a limb pixel on the window's edge may get its centre ray only (a small
@@ -34,6 +51,11 @@ pub const RING_MIN_WIDTH_PX: usize = 4;
 /// noise-free frame.
 pub const QUANTISATION_SIGMA_DN: f64 = 0.288_675_134_594_812_9;
 
+/// Noise σ from which a target pixel's noise-free contrast against its background counts
+/// as visible (the visible box, [module docs](self)): the usual single-pixel detection
+/// threshold, at which Gaussian noise alone crosses it on 0.13 % of pixels per sign.
+pub const VISIBLE_K_SIGMA: f64 = 3.0;
+
 /// The target's standing against its background ([module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clutter {
@@ -43,6 +65,22 @@ pub struct Clutter {
     pub clutter_sigma_dn: f64,
     /// Contrast over max(clutter σ, noise σ, [`QUANTISATION_SIGMA_DN`]).
     pub signal_to_clutter: f64,
+    /// Tight box of the target pixels visible beyond the noise ([module docs](self);
+    /// inside the truth box, empty when none is).
+    pub visible: Roi,
+}
+
+impl Clutter {
+    /// Visible box area / truth box area, 0..=1 (0 for an empty truth box): the IoU of
+    /// the visible box with the truth box, the ceiling of a detector that sees only the
+    /// pixels the target changes ([module docs](self)).
+    pub fn visible_share(&self, truth: Roi) -> f64 {
+        let area = |r: Roi| usize::from(r.width()) * usize::from(r.height());
+        if truth.is_empty() {
+            return 0.0;
+        }
+        area(self.visible) as f64 / area(truth) as f64
+    }
 }
 
 /// Width of the ring around a truth box, px: max([`RING_MIN_WIDTH_PX`], half the box's
@@ -64,13 +102,17 @@ pub fn ring_window(truth: Roi, width: usize, height: usize) -> Roi {
 }
 
 /// The statistics of [`Clutter`] from full-frame arrays: `signal` (with the target,
-/// noise-free), `background` (the twin), `coverage`, all `width` wide; `truth` the ½
-/// box; `gain_dn` DN per signal unit; `noise_sigma_dn` the frame's noise σ. `None`
-/// when the truth box is empty.
+/// noise-free, as the camera sees it), `background` (the twin: its ring gives the
+/// clutter σ, the scene's own variation), `seen_background` (the twin as the camera
+/// sees it, through the optics and signature like `signal`: the contrast and the
+/// visible box are against it),
+/// `coverage`, all `width` wide; `truth` the ½ box; `gain_dn` DN per signal unit;
+/// `noise_sigma_dn` the frame's noise σ. `None` when the truth box is empty.
 #[allow(clippy::too_many_arguments)]
 pub fn clutter_statistics(
     signal: &[f32],
     background: &[f32],
+    seen_background: &[f32],
     coverage: &[f32],
     width: usize,
     truth: Roi,
@@ -84,13 +126,20 @@ pub fn clutter_statistics(
     let window = ring_window(truth, width, height);
     let (mut diff, mut n_mask) = (0f64, 0usize);
     let (mut sum, mut sum2, mut n_ring) = (0f64, 0f64, 0usize);
+    let visible_dn = VISIBLE_K_SIGMA * noise_sigma_dn.max(QUANTISATION_SIGMA_DN);
+    let (mut vx0, mut vy0, mut vx1, mut vy1) = (usize::MAX, usize::MAX, 0usize, 0usize);
     for y in usize::from(window.y0)..usize::from(window.y1) {
         for x in usize::from(window.x0)..usize::from(window.x1) {
             let i = y * width + x;
             let b = f64::from(background[i]);
             if coverage[i] >= MASK_COVERAGE {
-                diff += f64::from(signal[i]) - b;
+                let d = f64::from(signal[i]) - f64::from(seen_background[i]);
+                diff += d;
                 n_mask += 1;
+                if (d * gain_dn).abs() >= visible_dn {
+                    (vx0, vy0) = (vx0.min(x), vy0.min(y));
+                    (vx1, vy1) = (vx1.max(x + 1), vy1.max(y + 1));
+                }
             }
             let inside = x >= usize::from(truth.x0)
                 && x < usize::from(truth.x1)
@@ -114,10 +163,17 @@ pub fn clutter_statistics(
         (sum2 / n_ring as f64 - m * m).max(0.0).sqrt() * gain_dn.abs()
     };
     let floor = sigma.max(noise_sigma_dn).max(QUANTISATION_SIGMA_DN);
+    // Inside the window, which is at most 1024 px wide (`u16` boxes).
+    let visible = if vx1 == 0 {
+        Roi::EMPTY
+    } else {
+        Roi::new(vx0 as u16, vy0 as u16, vx1 as u16, vy1 as u16)
+    };
     Some(Clutter {
         target_contrast_dn: contrast,
         clutter_sigma_dn: sigma,
         signal_to_clutter: contrast / floor,
+        visible,
     })
 }
 
@@ -164,9 +220,14 @@ pub fn signal_to_clutter(
             background[at..at + ww].copy_from_slice(line);
         }
     }
+    // The twin as the camera sees it, for the visible box: the frame's signal went
+    // through the optics and signature; outside the window the twin is 0, which the
+    // PSF's 2-px reach carries no farther than the ring (≥ 4 px) into the window.
+    let seen = super::through_the_optics(input, background.clone())?;
     Ok(clutter_statistics(
         &frame.signal,
         &background,
+        &seen,
         &frame.coverage,
         w,
         frame.truth,
@@ -216,17 +277,17 @@ mod tests {
         assert_eq!(truth, Roi::new(15, 15, 25, 25));
         assert_eq!(ring_width_px(truth), 5);
         assert_eq!(ring_window(truth, w, h), Roi::new(10, 10, 30, 30));
-        let got = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.5).unwrap();
         let close = |x: f64, y: f64| (x - y).abs() < 1e-9 * y.abs().max(1.0);
         assert!(close(got.target_contrast_dn, f64::from(c) * g), "{got:?}");
         assert!(close(got.clutter_sigma_dn, f64::from(a) * g), "{got:?}");
         assert!(close(got.signal_to_clutter, f64::from(c / a)), "{got:?}");
         // A noise σ above the clutter becomes the denominator.
-        let noisy = clutter_statistics(&sig, &bg, &cov, w, truth, g, 60.0).unwrap();
+        let noisy = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 60.0).unwrap();
         assert!(close(noisy.signal_to_clutter, f64::from(c) * g / 60.0));
         // A flat background, no noise: the quantisation floor 1/√12 DN.
         let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, 0.0);
-        let flat = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.0).unwrap();
+        let flat = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.0).unwrap();
         assert_eq!(flat.clutter_sigma_dn, 0.0);
         assert!(close(
             flat.signal_to_clutter,
@@ -234,8 +295,56 @@ mod tests {
         ));
         // A darker target: the contrast's magnitude.
         let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, -c, b0, a);
-        let dark = clutter_statistics(&sig, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let dark = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.5).unwrap();
         assert!(close(dark.target_contrast_dn, f64::from(c) * g));
+    }
+
+    #[test]
+    fn visible_box_holds_the_pixels_beyond_the_noise_only() {
+        // A 10 × 6 target at [10, 20) × [12, 18) in a 40 × 30 frame over a flat
+        // background: its left 4 columns at contrast 10, the other 6 at 2.9 (below
+        // 3 σ of σ = 1 DN at unit gain), so the visible box is [10, 14) × [12, 18),
+        // share 24 / 60. Every target pixel at contrast 3.0 (≥ 3σ): the whole truth box.
+        let (w, h) = (40, 30);
+        let bg = vec![50f32; w * h];
+        let mut cov = vec![0f32; w * h];
+        let mut sig = bg.clone();
+        for y in 12..18 {
+            for x in 10..20 {
+                cov[y * w + x] = 1.0;
+                sig[y * w + x] += if x < 14 { 10.0 } else { 2.9 };
+            }
+        }
+        let truth = super::super::mask_box(&cov, w);
+        assert_eq!(truth, Roi::new(10, 12, 20, 18));
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, 1.0, 1.0).unwrap();
+        assert_eq!(got.visible, Roi::new(10, 12, 14, 18));
+        assert!((got.visible_share(truth) - 0.4).abs() < 1e-12);
+        // Darker pixels count by their magnitude; a gain of 2 DN per unit doubles the
+        // contrast in DN: 2.9 → 5.8 DN ≥ 3 DN, so everything is visible.
+        let dark: Vec<f32> = sig.iter().zip(&bg).map(|(s, b)| 2.0 * b - s).collect();
+        let got = clutter_statistics(&dark, &bg, &bg, &cov, w, truth, 2.0, 1.0).unwrap();
+        assert_eq!(got.visible, truth);
+        assert_eq!(got.visible_share(truth), 1.0);
+        // The camera's offsets: a seen background 10 units above the twin (a
+        // signature offset the frame's signal carries too) is what the target is
+        // compared with, so a target at exactly that offset is invisible.
+        let seen: Vec<f32> = bg.iter().map(|b| b + 10.0).collect();
+        let got = clutter_statistics(&sig, &bg, &seen, &cov, w, truth, 1.0, 1.0).unwrap();
+        assert_eq!(
+            got.visible,
+            Roi::new(14, 12, 20, 18),
+            "7.1 below the offset only"
+        );
+        // The contrast is against the seen twin too: (24 × 0 + 36 × (2.9 − 10)) / 60.
+        assert!(
+            (got.target_contrast_dn - 36.0 * 7.1 / 60.0).abs() < 1e-5,
+            "{got:?}"
+        );
+        let flat: Vec<f32> = bg.iter().map(|b| b + 10.0).collect();
+        let got = clutter_statistics(&flat, &bg, &seen, &cov, w, truth, 1.0, 1.0).unwrap();
+        assert!(got.visible.is_empty());
+        assert_eq!(got.visible_share(truth), 0.0);
     }
 
     #[test]
@@ -245,7 +354,7 @@ mod tests {
         assert_eq!(ring_window(truth, 5, 50), Roi::new(0, 0, 5, 6));
         let z = vec![0f32; 16];
         assert_eq!(
-            clutter_statistics(&z, &z, &z, 4, Roi::EMPTY, 1.0, 0.0),
+            clutter_statistics(&z, &z, &z, &z, 4, Roi::EMPTY, 1.0, 0.0),
             None
         );
         assert_eq!(QUANTISATION_SIGMA_DN, 1.0 / 12f64.sqrt());

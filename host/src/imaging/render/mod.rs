@@ -385,6 +385,46 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     })
 }
 
+/// Radiance → `input.readout`'s signal unit, sr: F = π·L in radiometry, q_fc =
+/// L·ΔA_c/r² (face-on) in detection.
+fn signal_per_radiance_sr(input: &RenderInput<'_>) -> f64 {
+    match input.readout {
+        Readout::Radiometry => std::f64::consts::PI,
+        Readout::Detection(_) => SENSOR_AREA_M2 / input.earth_distance_m / input.earth_distance_m,
+    }
+}
+
+/// A scene signal frame of `input.camera`'s size as the detector array receives it: the
+/// optics PSF of `input.sensor`, then its signature (each only when it is on). Linear
+/// per pixel, so the difference of two frames through it is the difference blurred and
+/// scaled by the pixel gains (the signature's offsets cancel).
+///
+/// # Errors
+/// [`RenderError::Input`] for a signal or signature of another size than the camera's.
+pub fn through_the_optics(
+    input: &RenderInput<'_>,
+    mut signal: Vec<f32>,
+) -> Result<Vec<f32>, RenderError> {
+    let (w, h) = (input.camera.width, input.camera.height);
+    if let Some(psf) = input.sensor.psf {
+        let mut blurred = vec![0f32; signal.len()];
+        psf.apply(&signal, w, &mut blurred)
+            .map_err(RenderError::Input)?;
+        signal = blurred;
+    }
+    if let Some(sig) = input.sensor.signature {
+        if sig.width != w || sig.height != h {
+            return Err(RenderError::Input(format!(
+                "sensor signature of {} × {} px for a {} × {} camera: expected the camera's size",
+                sig.width, sig.height, w, h
+            )));
+        }
+        sig.apply(&mut signal, signal_per_radiance_sr(input))
+            .map_err(RenderError::Input)?;
+    }
+    Ok(signal)
+}
+
 /// A signal frame read out: what [`read_out`] returns.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReadOut {
@@ -423,28 +463,8 @@ pub fn read_out(
             signal.len()
         )));
     }
-    // Radiance → this readout's signal unit: F = π·L, q_fc = L·ΔA_c/r² (face-on).
-    let signal_per_radiance_sr = match input.readout {
-        Readout::Radiometry => std::f64::consts::PI,
-        Readout::Detection(_) => SENSOR_AREA_M2 / input.earth_distance_m / input.earth_distance_m,
-    };
     let ts = Instant::now();
-    if let Some(psf) = input.sensor.psf {
-        let mut blurred = vec![0f32; n];
-        psf.apply(&signal, w, &mut blurred)
-            .map_err(RenderError::Input)?;
-        signal = blurred;
-    }
-    if let Some(sig) = input.sensor.signature {
-        if sig.width != w || sig.height != h {
-            return Err(RenderError::Input(format!(
-                "sensor signature of {} × {} px for a {} × {} camera: expected the camera's size",
-                sig.width, sig.height, w, h
-            )));
-        }
-        sig.apply(&mut signal, signal_per_radiance_sr)
-            .map_err(RenderError::Input)?;
-    }
+    signal = through_the_optics(input, signal)?;
     if input.sensor.psf.is_some() || input.sensor.signature.is_some() {
         stats.sensor_ns = ts.elapsed().as_nanos() as u64;
     }
@@ -504,7 +524,7 @@ pub fn read_out(
             let dn_per_k = mapping.dn_per_kelvin(
                 input.band,
                 input.camera.netd_reference_k,
-                signal_per_radiance_sr,
+                signal_per_radiance_sr(input),
             )?;
             let level = NoiseLevel::Netd {
                 netd_k: input.camera.netd_k,
