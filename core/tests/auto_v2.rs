@@ -42,14 +42,18 @@ fn params() -> impl Strategy<Value = AutoV2> {
         prop_oneof![Just(550u16), Just(0u16), 0u16..=1000],
         0u8..=8,
         body_params(),
+        any::<bool>(),
     )
         .prop_map(
-            |(fine_sigma, cell_score, min_score_permille, saturated_erode_px, body)| AutoV2 {
-                fine_sigma,
-                cell_score,
-                min_score_permille,
-                saturated_erode_px,
-                body,
+            |(fine_sigma, cell_score, min_score_permille, saturated_erode_px, body, prescreen)| {
+                AutoV2 {
+                    fine_sigma,
+                    cell_score,
+                    min_score_permille,
+                    saturated_erode_px,
+                    body,
+                    prescreen,
+                }
             },
         )
 }

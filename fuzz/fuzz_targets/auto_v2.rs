@@ -34,6 +34,7 @@ fuzz_target!(|data: &[u8]| {
         } else {
             BodyParams::OFF
         },
+        prescreen: data[8] & 0x40 == 0,
     };
     let dn: Vec<u16> = data[9..]
         .chunks_exact(2)

@@ -214,7 +214,9 @@ pub fn cell_features(
     // The cell is inside the plane (`get`: no panic path if not).
     let i = cy * pw + cx;
     let m = i64::from(mean_dn.get(i).copied().unwrap_or(0));
-    let s = lv.sigma;
+    // σ ≥ 1 (`levels`); `max` again so the divisions below carry no panic path when
+    // this function is not inlined into its caller (the cascade's classify closure).
+    let s = lv.sigma.max(1);
     let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(s));
     out[0] = ((m - i64::from(lv.p50)) * 256 / range).clamp(-4096, 4096) as i32;
     out[1] = slog(m - i64::from(lv.p2), s);

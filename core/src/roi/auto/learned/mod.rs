@@ -27,6 +27,7 @@ pub mod forest;
 mod forest_trees;
 pub mod half_max;
 pub mod order;
+pub mod prescreen;
 pub mod saturated;
 pub mod shape;
 
@@ -70,6 +71,10 @@ pub struct AutoV2 {
     /// The whole body grown from the winner ([`body`]: faces hotter and colder than
     /// the background joined to it). [`body::BodyParams::OFF`] turns it off.
     pub body: body::BodyParams,
+    /// Stage 3's cascade ([`prescreen`]): classify only the seed cells and the
+    /// neighbours of target cells (the same components, unless one holds no seed).
+    /// Default on; off classifies every cell (the cost's worst case).
+    pub prescreen: bool,
 }
 
 impl Default for AutoV2 {
@@ -80,6 +85,7 @@ impl Default for AutoV2 {
             min_score_permille: 550,
             saturated_erode_px: 2,
             body: body::BodyParams::DEFAULT,
+            prescreen: true,
         }
     }
 }
@@ -228,55 +234,57 @@ pub fn for_each_cell_features<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
     mut f: impl FnMut(usize, usize, &[i32; FEATURES]),
 ) -> u32 {
-    let (_, lv) = cell_pass(frame, work, |cx, cy, feats| {
+    let (_, lv) = cell_pass(frame, work, false, |cx, cy, feats| {
         f(cx, cy, feats);
         0
     });
     lv.sigma
 }
 
-/// Stages 1–3: prepares the planes ([`prepare`]), computes every 8×8 cell's features
-/// (with its 4×4-pixel windows, [`cells::sub_window_extremes`]) and stores the code
-/// `code(cx, cy, features)` returns in `labels4[cy · pw + cx]`. The one cell loop of
-/// both the detector and the training dump.
+/// Stages 1–3: prepares the planes ([`prepare`]), computes the features of the 8×8
+/// cells (with their 4×4-pixel windows, [`cells::sub_window_extremes`]) and stores the
+/// code `code(cx, cy, features)` returns in `labels4[cy · pw + cx]`: of every cell
+/// (`screen` false), or of the cells [`prescreen::cascade`] reaches (`screen` true; the
+/// others 0). The one cell loop of both the detector and the training dump.
 fn cell_pass<C: FrameCapacity>(
     frame: &Frame<'_>,
     work: &mut AutoV2Work<C>,
+    screen: bool,
     mut code: impl FnMut(usize, usize, &[i32; FEATURES]) -> u8,
 ) -> ((usize, usize), FrameLevels) {
     let win = Window::full(frame);
     let (plane, lv) = prepare(frame, work, win);
-    let n = plane.0 * plane.1;
     let ints = Integrals {
         sum: work.sum.as_mut(),
         sum_sq: work.sum_sq.as_mut(),
         sum_q: work.sum_q.as_mut(),
         edges: work.edges.as_mut(),
     };
-    let codes = work.labels4.as_mut();
+    let (mean_dn, step_code) = (work.mean_dn.as_ref(), work.step_code.as_ref());
     let mut feats = [0i32; FEATURES];
-    for cy in 0..plane.1 {
-        for cx in 0..plane.0 {
-            let sub = cells::sub_window_extremes(frame, win, (cx, cy));
-            cell_features(
-                work.mean_dn.as_ref(),
-                work.step_code.as_ref(),
-                &ints,
-                plane,
-                lv,
-                (cx, cy),
-                sub,
-                &mut feats,
-            );
-            let c = code(cx, cy, &feats);
-            if let Some(slot) = codes
-                .get_mut(..n)
-                .and_then(|c| c.get_mut(cy * plane.0 + cx))
-            {
-                *slot = c;
-            }
-        }
-    }
+    let classify = |cx: usize, cy: usize| {
+        let sub = cells::sub_window_extremes(frame, win, (cx, cy));
+        cell_features(
+            mean_dn,
+            step_code,
+            &ints,
+            plane,
+            lv,
+            (cx, cy),
+            sub,
+            &mut feats,
+        );
+        code(cx, cy, &feats)
+    };
+    // `labels8` (the marks) and `dilated4` (the worklist) are free until stage 4.
+    prescreen::cascade(
+        plane,
+        work.labels4.as_mut(),
+        work.labels8.as_mut(),
+        work.dilated4.as_mut(),
+        |cx, cy| !screen || prescreen::is_seed(mean_dn, step_code, ints.sum, plane, &lv, (cx, cy)),
+        classify,
+    );
     (plane, lv)
 }
 
@@ -345,7 +353,7 @@ impl AutoV2 {
         // Stage 3: classify the cells; codes 1..=255 for target cells (the score
         // above the cell threshold, in quarter units of log-odds), 0 otherwise.
         let cell_score = i32::from(self.cell_score);
-        let (plane8, lv) = cell_pass(frame, work, |_, _, feats| {
+        let (plane8, lv) = cell_pass(frame, work, self.prescreen, |_, _, feats| {
             // The flat form of `forest_trees.rs` (built at compile time; the same
             // score as walking its nodes, `forest::score`).
             let s = forest::FLIGHT.score(feats);
@@ -561,7 +569,7 @@ impl core::fmt::Display for AutoV2 {
             f,
             "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
              body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
-             body_trim_permille={}",
+             body_trim_permille={} prescreen={}",
             self.fine_sigma,
             self.cell_score,
             self.min_score_permille,
@@ -570,7 +578,8 @@ impl core::fmt::Display for AutoV2 {
             self.body.ring_from_cells,
             self.body.ring_to_cells,
             self.body.max_share_permille,
-            self.body.trim_permille
+            self.body.trim_permille,
+            self.prescreen
         )
     }
 }
@@ -827,6 +836,48 @@ mod tests {
         let at = |c: (usize, usize)| got.iter().find(|g| (g.0, g.1) == c).unwrap().2;
         assert!(at((20, 5))[o] > log_code(4 * 100), "{:?}", at((20, 5)));
         assert!(at((2, 25))[o + 1] < -log_code(4 * 100), "{:?}", at((2, 25)));
+    }
+
+    /// The pre-screen's seed rule on the planes (`prescreen::is_seed`, what the detector
+    /// runs) equals the rule on the cell's features (`is_seed_features`, what the checks
+    /// on feature dumps use), on textured frames at three bit depths; and the detector
+    /// with the cascade finds the same box as the full pass on them.
+    #[test]
+    fn seed_rule_on_planes_equals_rule_on_features() {
+        let mut seeds = 0;
+        for (seed, bits) in [(3, 14), (5, 12), (9, 16)] {
+            let px = frame_pixels(seed, bits);
+            let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, bits).unwrap();
+            let mut work: std::boxed::Box<AutoV2Work> = std::boxed::Box::new(ConstInit::INIT);
+            let mut want = std::vec::Vec::new();
+            for_each_cell_features(&frame, &mut work, |_, _, f| {
+                want.push(prescreen::is_seed_features(f))
+            });
+            let (plane, lv) = prepare(&frame, &mut work, Window::full(&frame));
+            for cy in 0..plane.1 {
+                for cx in 0..plane.0 {
+                    let got = prescreen::is_seed(
+                        work.mean_dn.as_ref(),
+                        work.step_code.as_ref(),
+                        work.sum.as_ref(),
+                        plane,
+                        &lv,
+                        (cx, cy),
+                    );
+                    assert_eq!(got, want[cy * plane.0 + cx], "({cx}, {cy}) seed {seed}");
+                    seeds += usize::from(got);
+                }
+            }
+            let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+            let on = AutoV2::default().detect(&frame, &mut scratch).unwrap();
+            let full = AutoV2 {
+                prescreen: false,
+                ..AutoV2::default()
+            };
+            assert_eq!(on, full.detect(&frame, &mut scratch).unwrap());
+        }
+        // Both outcomes occur (the block's outline seeds, the flat texture does not).
+        assert!(seeds > 0 && seeds < 3 * 41 * 31, "{seeds}");
     }
 
     #[test]
