@@ -14,14 +14,27 @@
 //! | 21, 22 | `slog((hot − ref)/σ)`, `slog((cold − ref)/σ)`: the hottest and coldest 4×4-pixel window of the cell ([`super::cells::sub_window_extremes`]) against `ref`, the mean of the 8 neighbouring cells |
 //! | 23, 24 | `(hot − ref) · 16 / max(sd₂, σ)`, `(cold − ref) · 16 / max(sd₂, σ)`: the same in the 16-px box's own σ (clutter) |
 //! | 25, 26 | `slog((hot − m)/σ)`, `slog((cold − m)/σ)`: a small target inside the cell against the cell's own mean |
+//! | 27, 28 | `slog((cold − p2)/σ)`, `slog((hot − p98)/σ)`: the coldest (hottest) window against the frame's low (high) end of cell means: a cold face below every cloud top, a hot one above every warm cell |
+//! | 29 | `log((hot − cold)/σ)`: the spread of the cell's windows (a target's flat face vs cloud texture) |
+//! | 30 | `max(|hot − ref|, |cold − ref|) · 16 / max(sd₂, σ)`: the window's departure from its neighbours in clutter units, either sign (a cold target and a hot one alike) |
+//! | 31 | `min(cx, cy, pw − 1 − cx, ph − 1 − cy, 8)`: cells to the frame's edge (the context boxes are cut there; a target cut by the frame) |
 //!
 //! `m`: the cell's mean DN; `p2`, `p50`, `p98`: percentiles of the frame's cell
 //! means; `log(x)` = [`log_code`] of `4x` (16 codes per octave of quarter-σ units),
 //! `slog` its signed form; a box is cut to the plane (its mean and standard deviation
 //! `sd` over the cells inside).
 
-/// Features per cell: 5 of the cell, 4 per context box, 6 of its 4×4-pixel windows.
-pub const FEATURES: usize = 5 + 4 * RADII_CELLS.len() + SUB_FEATURES;
+/// Features per cell: 5 of the cell, 4 per context box, 6 of its 4×4-pixel windows,
+/// 5 against the frame's ends, the windows' spread, either sign and the frame's edge.
+pub const FEATURES: usize = 5 + 4 * RADII_CELLS.len() + SUB_FEATURES + FRAME_FEATURES;
+
+/// Features of the windows against the frame and of the cell's place (indices 27–31;
+/// issue 16's radiometry targets: cold, flat, cut by the frame).
+pub const FRAME_FEATURES: usize = 5;
+
+/// Largest value of feature 31, cells: the largest context box's radius (a cell at
+/// least this far from every frame edge has all its boxes whole).
+pub const EDGE_DISTANCE_MAX_CELLS: usize = 8;
 
 /// Features of the finer 4×4-pixel windows (indices 21–26).
 pub const SUB_FEATURES: usize = 6;
@@ -261,4 +274,16 @@ pub fn cell_features(
     out[o + 3] = clutter(cold - reference);
     out[o + 4] = slog(hot - m, s);
     out[o + 5] = slog(cold - m, s);
+    let o = o + SUB_FEATURES;
+    out[o] = slog(cold - i64::from(lv.p2), s);
+    out[o + 1] = slog(hot - i64::from(lv.p98), s);
+    out[o + 2] = slog(hot - cold, s);
+    let departure = (hot - reference).abs().max((cold - reference).abs());
+    out[o + 3] = clutter(departure);
+    let to_edge = cx
+        .min(cy)
+        .min(pw.saturating_sub(1 + cx))
+        .min(ph.saturating_sub(1 + cy))
+        .min(EDGE_DISTANCE_MAX_CELLS);
+    out[o + 4] = to_edge as i32;
 }

@@ -789,6 +789,14 @@ mod tests {
             if d < 0 { -log_code(q) } else { log_code(q) }
         };
         let o = 5 + 4 * features::RADII_CELLS.len();
+        // The frame's cell-mean percentiles by a sort.
+        let mut sorted: std::vec::Vec<i64> = (0..pw * ph).map(|i| mean(i % pw, i / pw)).collect();
+        sorted.sort_unstable();
+        let last = sorted.len() - 1;
+        let (p2, p98) = (sorted[last * 2 / 100], sorted[last * 98 / 100]);
+        let at_cell = |got: &[(usize, usize, [i32; FEATURES])], c: (usize, usize)| {
+            got.iter().find(|g| (g.0, g.1) == c).unwrap().2
+        };
         let mut checked_spots = 0;
         for &(cx, cy, f) in &got {
             let spot = (cx, cy) == (20, 5) || (cx, cy) == (2, 25);
@@ -830,8 +838,31 @@ mod tests {
                 assert!(v == 0 || v.signum() == d.signum(), "({cx}, {cy}) {k}");
                 assert!(v.abs() <= (d.abs() * 16 / i64::from(sigma)).max(1));
             }
+            // The frame features (27–31): the windows against the sorted cell means'
+            // 2nd and 98th percentiles, their spread, the departure of either sign, the
+            // cells to the frame's edge counted by hand.
+            let q = o + features::SUB_FEATURES;
+            assert_eq!(f[q], slog(cold - p2), "cold vs p2, ({cx}, {cy})");
+            assert_eq!(f[q + 1], slog(hot - p98), "hot vs p98, ({cx}, {cy})");
+            assert_eq!(f[q + 2], slog(hot - cold), "spread, ({cx}, {cy})");
+            assert!(f[q + 2] >= 0);
+            assert_eq!(
+                f[q + 3],
+                f[o + 2].abs().max(f[o + 3].abs()),
+                "departure ({cx}, {cy})"
+            );
+            let edge = [cx, cy, pw - 1 - cx, ph - 1 - cy, 8]
+                .into_iter()
+                .min()
+                .unwrap();
+            assert_eq!(f[q + 4], edge as i32, "edge distance, ({cx}, {cy})");
         }
         assert_eq!(checked_spots, 2);
+        // The spots: the cold one below the frame's low end, the hot one above its top.
+        let q = o + features::SUB_FEATURES;
+        assert!(at_cell(&got, (2, 25))[q] < -log_code(4 * 100));
+        assert!(at_cell(&got, (20, 5))[q + 1] > log_code(4 * 20));
+        assert!(at_cell(&got, (20, 5))[q + 2] > log_code(4 * 20));
         // The spots stand out: a hot window far above its neighbours, a cold one far below.
         let at = |c: (usize, usize)| got.iter().find(|g| (g.0, g.1) == c).unwrap().2;
         assert!(at((20, 5))[o] > log_code(4 * 100), "{:?}", at((20, 5)));
