@@ -418,6 +418,7 @@ impl AutoV2 {
             work.dilated4.as_ref().get(..n8).unwrap_or_default(),
             &work.labels4.as_ref()[..n8],
             &work.mean_dn.as_ref()[..n8],
+            &work.step_code.as_ref()[..n8],
             plane8,
             (
                 usize::from(w8.x0),
@@ -893,6 +894,7 @@ mod tests {
                     perimeter_cells: 4 * u16::from(w),
                     contrast_code: 40,
                     clutter_code: 20,
+                    ..shape::WinnerShape::default()
                 },
             };
             let f = win.confidence_features();
