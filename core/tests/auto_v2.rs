@@ -144,6 +144,30 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
             }
         }
     }
+    // The winner's shape statistics are consistent with its cells and the frame
+    // (`learned::shape`): cell sides on the frame's edge are outline, the reach stays
+    // inside half the cell plane, a span joins two touched sides, interior cells are
+    // cells, and without one their step code is 0.
+    if let Some(w) = scratch.work().winner() {
+        let sh = w.shape;
+        let (pw, ph) = (img.w.div_ceil(8), img.h.div_ceil(8));
+        prop_assert!(sh.edge_sides <= sh.perimeter_cells, "{w:?}");
+        prop_assert_eq!(sh.edge_sides == 0, w.sides == 0, "{:?}", w);
+        prop_assert!(
+            usize::from(sh.reach_cells) < pw.max(ph).div_ceil(2),
+            "{w:?}"
+        );
+        prop_assert!(
+            sh.spans <= 2 && u8::from(sh.spans > 0) * 2 <= w.sides,
+            "{w:?}"
+        );
+        prop_assert!(sh.interior_cells <= w.cells, "{w:?}");
+        if sh.interior_cells == 0 {
+            prop_assert_eq!(sh.interior_step_code, 0);
+        }
+        let feats = w.confidence_features();
+        prop_assert!(feats.iter().all(|&v| v > -2000 && v <= 16_000), "{feats:?}");
+    }
     // Same answer twice: the same scratch, a fresh one, and through the registry.
     prop_assert_eq!(det.detect(&f, &mut scratch).unwrap(), d);
     prop_assert_eq!(det.detect(&f, &mut AutoV2Scratch::new()).unwrap(), d);

@@ -165,7 +165,7 @@ fn main() {
                     Some(w) => {
                         let _ = writeln!(
                             s,
-                            ",{},{},{},{},{},{},{},{},{},{},{}",
+                            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                             w.cells,
                             w.box_w_cells,
                             w.box_h_cells,
@@ -176,10 +176,17 @@ fn main() {
                             w.runner_up_permille,
                             w.shape.perimeter_cells,
                             w.shape.contrast_code,
-                            w.shape.clutter_code
+                            w.shape.clutter_code,
+                            w.shape.edge_sides,
+                            w.shape.reach_cells,
+                            w.shape.spans,
+                            w.shape.spread_code,
+                            w.shape.step_mean_code,
+                            w.shape.interior_cells,
+                            w.shape.interior_step_code
                         );
                     }
-                    None => s.push_str(",,,,,,,,,,,\n"),
+                    None => s.push_str(",,,,,,,,,,,,,,,,,,\n"),
                 }
             }
             s
@@ -193,7 +200,8 @@ fn main() {
         h
     } else {
         "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up,\
-             perimeter,contrast_code,clutter_code"
+             perimeter,contrast_code,clutter_code,edge_sides,reach,spans,spread_code,step_mean_code,\
+             interior_cells,interior_step_code"
             .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");

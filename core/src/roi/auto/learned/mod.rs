@@ -10,9 +10,10 @@
 //! half maximum ([`half_max`]: far targets' blur) and a saturated blob by the optics'
 //! reach ([`saturated`]).
 //! A box's confidence is a logistic model of P(hit) over statistics of the winner
-//! itself (its cells, sides touched, mean cell score and the contrast of its border
-//! against the ring of background around it in the ring's own spread, [`shape`]; none
-//! counts the background's other components), fitted on our renders
+//! itself (its cells, sides touched, mean cell score, the contrast of its border
+//! against the ring of background around it in the ring's own spread, the texture of
+//! its interior cells and whether it is small (1–2 cells), [`shape`]; none counts the
+//! background's other components), fitted on our renders
 //! (`confidence_weights.rs`).
 //!
 //! Unlike `auto`'s "the outline is a step" rule, the region stage learns what the
@@ -58,7 +59,9 @@ pub struct AutoV2 {
     /// below this are dropped (no target), ‰: 0..=1000. Default 550: on family A
     /// (famA25, paperAm, fixA), the lowest threshold in steps of 50 whose false alarms
     /// stay ≤ 2 % on the no-target frames of every kind (realistic 1 of 60, fixtures 0
-    /// of 80; 500: realistic 2 of 60).
+    /// of 80; 500: realistic 2 of 60). Re-chosen by the same rule for session 26's
+    /// refitted confidence: 550 again (realistic 1 of 60, its second-highest no-target
+    /// winner at 525; fixtures' highest 489).
     pub min_score_permille: u16,
     /// A box that is a saturated blob is cut by this many pixels per side (off the
     /// frame's edges; [`saturated`]), px: 0..=8. A property of the camera: the reach of
@@ -115,7 +118,12 @@ pub struct Winner {
 }
 
 /// Number of the confidence model's features ([`Winner::confidence_features`]).
-pub const CONFIDENCE_FEATURES: usize = 11;
+pub const CONFIDENCE_FEATURES: usize = 24;
+
+/// A winner of at most this many 8×8 cells is "small" for the confidence's size-class
+/// terms, cells: a far target of 3–12 px lies in one or two cells, and a linear weight
+/// on the cell count alone rates it like a single noise cell.
+pub const SMALL_WINNER_CELLS: u16 = 2;
 
 impl Winner {
     /// The confidence model's integer features (`scripts/train-auto.py` computes the
@@ -124,25 +132,51 @@ impl Winner {
     /// log code of the component count, the runner-up ‰, and the winner's own shape
     /// ([`shape::WinnerShape`]): compactness ‰ (16 · cells / perimeter², 1000 for a
     /// square, capped there), the border contrast in σ and in the ring's spread (log
-    /// codes). Which of them the model uses is `confidence_weights.rs`' choice (weight 0:
-    /// unused).
+    /// codes); then how it meets the frame's edge and how flat it is: log codes of its
+    /// cell sides on the frame's edge and of its reach into the frame, the sides it
+    /// spans, the spread of its cells' levels (log code) and that minus the contrast in
+    /// σ (a log ratio), its mean step code, its interior cells ‰ of its cells, their
+    /// mean step code, the straightness ‰ (its cell box's outline over its own, capped
+    /// at 1000); and terms per size class: small (at most [`SMALL_WINNER_CELLS`]: 1,
+    /// else 0), small × the clutter contrast, small × the mean code × 16, and "touches
+    /// the frame's edge" × the mean code × 16. Which of them the model uses is
+    /// `confidence_weights.rs`' choice (weight 0: unused).
     pub fn confidence_features(&self) -> [i32; CONFIDENCE_FEATURES] {
         let cells = u32::from(self.cells).max(1);
         let area = u32::from(self.box_w_cells) * u32::from(self.box_h_cells);
-        let perimeter = u64::from(self.shape.perimeter_cells).max(1);
+        let sh = &self.shape;
+        let perimeter = u64::from(sh.perimeter_cells).max(1);
         let compact = (16 * u64::from(cells) * 1000 / (perimeter * perimeter)).min(1000);
+        let box_outline = 2 * (u64::from(self.box_w_cells) + u64::from(self.box_h_cells));
+        let straight = (box_outline * 1000 / perimeter).min(1000);
+        let mean16 = (self.code_sum * 16 / cells) as i32;
+        let clutter = i32::from(sh.clutter_code);
+        let small = i32::from(self.cells <= SMALL_WINNER_CELLS);
         [
             features::log_code(cells - 1),
             features::log_code(area.max(1) - 1),
             (cells * 1000 / area.max(1)) as i32,
             i32::from(self.sides),
-            (self.code_sum * 16 / cells) as i32,
+            mean16,
             i32::from(self.code_max),
             features::log_code(u32::from(self.components)),
             i32::from(self.runner_up_permille),
             compact as i32,
-            i32::from(self.shape.contrast_code),
-            i32::from(self.shape.clutter_code),
+            i32::from(sh.contrast_code),
+            clutter,
+            features::log_code(u32::from(sh.edge_sides)),
+            features::log_code(u32::from(sh.reach_cells)),
+            i32::from(sh.spans),
+            i32::from(sh.spread_code),
+            i32::from(sh.spread_code) - i32::from(sh.contrast_code),
+            i32::from(sh.step_mean_code),
+            (u32::from(sh.interior_cells) * 1000 / cells) as i32,
+            i32::from(sh.interior_step_code),
+            straight as i32,
+            small,
+            small * clutter,
+            small * mean16,
+            i32::from(self.sides > 0) * mean16,
         ]
     }
 
@@ -426,6 +460,7 @@ impl AutoV2 {
             work.dilated4.as_ref().get(..n8).unwrap_or_default(),
             &work.labels4.as_ref()[..n8],
             &work.mean_dn.as_ref()[..n8],
+            &work.step_code.as_ref()[..n8],
             plane8,
             (
                 usize::from(w8.x0),
@@ -975,6 +1010,7 @@ mod tests {
                     perimeter_cells: 4 * u16::from(w),
                     contrast_code: 40,
                     clutter_code: 20,
+                    ..shape::WinnerShape::default()
                 },
             };
             let f = win.confidence_features();
