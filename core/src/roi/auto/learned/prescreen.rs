@@ -1,4 +1,4 @@
-//! Stage 3's cascade: the cell's 4×4-pixel windows, its 27 features and the forest run
+//! Stage 3's cascade: the cell's 4×4-pixel windows, its features and the forest run
 //! only where a target cell can be, and every other cell scores as background (code 0).
 //!
 //! Two steps ([`cascade`]):
@@ -24,14 +24,6 @@
 //! the forest is retrained).
 
 use super::features::{FEATURES, FrameLevels, RADII_CELLS, log_code};
-
-/// A cell whose largest two-pixel step reaches this [`log_code`] (of 4 · step / σ) is
-/// a candidate.
-pub const STEP_CODE_MIN: i32 = 0;
-
-/// A cell whose mean differs from a context box's mean by at least this [`log_code`]
-/// (of 4 · |difference| / σ, the magnitude of features 5 + 4k) is a candidate.
-pub const CONTRAST_CODE_MIN: i32 = 0;
 
 /// A cell whose largest two-pixel step reaches this [`log_code`] (of 4 · step / σ;
 /// feature 3) is a seed. 90: a step of about 13 σ (`log_code(52) = 90`); a noise
