@@ -16,41 +16,16 @@
 //! cut (`AutoV2::saturated_erode_px`, px per side) and the body stage's parameters
 //! (`BodyParams`: k_sigma, ring_from_cells, ring_to_cells, max_share_permille,
 //! trim_permille; `k_sigma` 0 turns the stage off).
+mod common;
+
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, AutoV2Work, for_each_cell_features};
 use tirroi_host::imaging::image_io::read_frame;
-
-/// A frame of the dataset: file, bit depth, and the truth box (½ convention; `None`
-/// without a target).
-type Entry = (String, u8, Option<[usize; 4]>);
-
-fn frames(dir: &Path) -> Vec<Entry> {
-    let meta = std::fs::read_to_string(dir.join("metadata.jsonl")).expect("metadata.jsonl");
-    meta.lines()
-        .map(|l| {
-            let v: serde_json::Value = serde_json::from_str(l).expect("json");
-            let bbox = v["bbox"].as_array().and_then(|b| {
-                let c: Vec<usize> = b
-                    .iter()
-                    .filter_map(|x| x.as_u64())
-                    .map(|x| x as usize)
-                    .collect();
-                (c.len() == 4 && v["target"].as_str() != Some("none"))
-                    .then(|| [c[0], c[1], c[2], c[3]])
-            });
-            (
-                v["file"].as_str().expect("file").to_string(),
-                v["bits"].as_u64().unwrap_or(14) as u8,
-                bbox,
-            )
-        })
-        .collect()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -90,7 +65,7 @@ fn main() {
     if let Some(v) = num(10) {
         body.trim_permille = v;
     }
-    let list = frames(&dir);
+    let list = common::frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
         .enumerate()
@@ -111,11 +86,13 @@ fn main() {
                                 n += 1;
                             }
                         }
-                    } else if let Some([x0, y0, x1, y1]) = bbox {
+                    } else if let Some(b) = bbox {
                         // Without masks (the test-set kinds): the truth box as the mask.
+                        let xs = usize::from(b.x0)..usize::from(b.x1);
+                        let ys = usize::from(b.y0)..usize::from(b.y1);
                         for y in cy * 8..cy * 8 + 8 {
                             for x in cx * 8..cx * 8 + 8 {
-                                cov += if (*x0..*x1).contains(&x) && (*y0..*y1).contains(&y) {
+                                cov += if xs.contains(&x) && ys.contains(&y) {
                                     255
                                 } else {
                                     0

@@ -18,58 +18,20 @@
 //! without a target), off → on. `dump` writes one line per cell of every frame:
 //! `frame,cx,cy,score,seed,f0..f26` (the forest's score, score units; whether the cell
 //! is a seed; the features).
+mod common;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
-use tirroi_core::roi::Roi;
 use tirroi_core::roi::auto::learned::features::FEATURES;
 use tirroi_core::roi::auto::learned::{
     AutoV2, AutoV2Scratch, AutoV2Work, for_each_cell_features, forest, prescreen,
 };
 use tirroi_host::eval::bank::saturated_erode_px_of_dataset;
 use tirroi_host::imaging::image_io::read_frame;
-
-/// A frame of the dataset: file, bit depth, truth box (½ convention; `None` without a
-/// target).
-type Entry = (String, u8, Option<Roi>);
-
-fn frames(dir: &Path) -> Vec<Entry> {
-    let path = dir.join("metadata.jsonl");
-    let meta = std::fs::read_to_string(&path).unwrap_or_else(|e| {
-        eprintln!("{}: {e}", path.display());
-        std::process::exit(2)
-    });
-    meta.lines()
-        .enumerate()
-        .map(|(n, l)| {
-            let v: serde_json::Value = serde_json::from_str(l).unwrap_or_else(|e| {
-                eprintln!("{}:{}: not JSON: {e}", path.display(), n + 1);
-                std::process::exit(2)
-            });
-            let bbox = v["bbox"].as_array().and_then(|b| {
-                let c: Vec<u16> = b
-                    .iter()
-                    .filter_map(|x| x.as_u64())
-                    .map(|x| x as u16)
-                    .collect();
-                (c.len() == 4 && v["target"].as_str() != Some("none"))
-                    .then(|| Roi::new(c[0], c[1], c[2], c[3]))
-            });
-            let Some(file) = v["file"].as_str() else {
-                eprintln!("{}:{}: no \"file\"", path.display(), n + 1);
-                std::process::exit(2)
-            };
-            (
-                file.to_string(),
-                v["bits"].as_u64().unwrap_or(14) as u8,
-                bbox,
-            )
-        })
-        .collect()
-}
 
 /// The detector's code of a cell score (`AutoV2::run`'s stage 3 at the default cell
 /// threshold): 0 below it, else 1 + the quarter units of log-odds above it.
@@ -161,7 +123,7 @@ fn check(dir: &Path) -> Tally {
         eprintln!("{e}");
         std::process::exit(2)
     });
-    let list = frames(dir);
+    let list = common::frames(dir);
     list.par_iter()
         .map(|(file, bits, truth)| {
             let f = read_frame(&dir.join(file), Some(*bits)).unwrap_or_else(|e| {
@@ -252,7 +214,7 @@ fn check(dir: &Path) -> Tally {
 }
 
 fn dump(dir: &Path, out: &Path) {
-    let list = frames(dir);
+    let list = common::frames(dir);
     let lines: Vec<String> = list
         .par_iter()
         .enumerate()
