@@ -19,7 +19,7 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, SCORE_FULL_PERMILLE};
 
@@ -43,9 +43,22 @@ fn params() -> impl Strategy<Value = AutoV2> {
         0u8..=8,
         body_params(),
         any::<bool>(),
+        prop_oneof![
+            Just(BlobRule::Compete),
+            Just(BlobRule::Off),
+            Just(BlobRule::Always)
+        ],
     )
         .prop_map(
-            |(fine_sigma, cell_score, min_score_permille, saturated_erode_px, body, prescreen)| {
+            |(
+                fine_sigma,
+                cell_score,
+                min_score_permille,
+                saturated_erode_px,
+                body,
+                prescreen,
+                blob,
+            )| {
                 AutoV2 {
                     fine_sigma,
                     cell_score,
@@ -53,6 +66,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     saturated_erode_px,
                     body,
                     prescreen,
+                    blob,
                 }
             },
         )
@@ -118,9 +132,16 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 img.h
             );
             prop_assert!(d.score_permille >= det.min_score_permille, "{d:?}");
-            // The confidence is the winner's (what telemetry reads).
-            let winner = scratch.work().winner().expect("a box has a winner");
-            prop_assert_eq!(winner.score_permille(), d.score_permille);
+            // The confidence is the winner's (what telemetry reads): the saturated
+            // blob's when it won, else the classifier's.
+            let work = scratch.work();
+            let score = if work.blob_won() {
+                prop_assert!(det.blob != BlobRule::Off, "{d:?}");
+                work.blob().expect("a blob won").score_permille()
+            } else {
+                work.winner().expect("a box has a winner").score_permille()
+            };
+            prop_assert_eq!(score, d.score_permille);
             // The threshold at the confidence keeps the same box; one ‰ above, `null`.
             let at = AutoV2 {
                 min_score_permille: d.score_permille,

@@ -13,7 +13,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use tirroi_core::roi::auto::learned::body::BodyParams;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
 use tirroi_core::{Detector, Frame, SCORE_FULL_PERMILLE};
 
 fuzz_target!(|data: &[u8]| {
@@ -35,6 +35,11 @@ fuzz_target!(|data: &[u8]| {
             BodyParams::OFF
         },
         prescreen: data[8] & 0x40 == 0,
+        blob: match data[3] / 64 {
+            0 => BlobRule::Off,
+            1 => BlobRule::Always,
+            _ => BlobRule::Compete,
+        },
     };
     let dn: Vec<u16> = data[9..]
         .chunks_exact(2)

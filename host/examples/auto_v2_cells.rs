@@ -15,7 +15,13 @@
 //! the cell threshold (`AutoV2::cell_score`, score units), the saturated blob's
 //! cut (`AutoV2::saturated_erode_px`, px per side) and the body stage's parameters
 //! (`BodyParams`: k_sigma, ring_from_cells, ring_to_cells, max_share_permille,
-//! trim_permille; `k_sigma` 0 turns the stage off).
+//! trim_permille; `k_sigma` 0 turns the stage off) and the saturated blob's rule
+//! (`AutoV2::blob`: `off`, `compete` (the default) or `always`, the blob model's
+//! training data; run the confidence model's `predict-all` with `off`: its winner
+//! statistics are the classifier's). Every line ends with
+//! the frame's largest saturated blob (`learned::blob::BlobStats`: saturated pixels,
+//! solidity ‰, ring depth ‰, others ‰, sides, its confidence ‰; empty without one),
+//! the blob model's training data (`scripts/train-auto.py --blob`).
 mod common;
 
 use std::fmt::Write as _;
@@ -24,7 +30,9 @@ use std::path::PathBuf;
 use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, AutoV2Work, for_each_cell_features};
+use tirroi_core::roi::auto::learned::{
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features,
+};
 use tirroi_host::imaging::image_io::read_frame;
 
 fn main() {
@@ -65,6 +73,17 @@ fn main() {
     if let Some(v) = num(10) {
         body.trim_permille = v;
     }
+    // Optional: the saturated blob's rule (default: `AutoV2::default()`'s).
+    let blob = match args.get(11).map(String::as_str) {
+        None => AutoV2::default().blob,
+        Some("off") => BlobRule::Off,
+        Some("compete") => BlobRule::Compete,
+        Some("always") => BlobRule::Always,
+        Some(v) => {
+            eprintln!("blob rule: off, compete or always, not {v:?}");
+            std::process::exit(2)
+        }
+    };
     let list = common::frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -119,6 +138,7 @@ fn main() {
                     cell_score,
                     saturated_erode_px: erode,
                     body,
+                    blob,
                     ..AutoV2::default()
                 };
                 let d = gate_off.detect(&frame, &mut scratch).expect("detect");
@@ -140,7 +160,7 @@ fn main() {
                 }
                 match scratch.work().winner() {
                     Some(w) => {
-                        let _ = writeln!(
+                        let _ = write!(
                             s,
                             ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                             w.cells,
@@ -163,7 +183,22 @@ fn main() {
                             w.shape.interior_step_code
                         );
                     }
-                    None => s.push_str(",,,,,,,,,,,,,,,,,,\n"),
+                    None => s.push_str(",,,,,,,,,,,,,,,,,,"),
+                }
+                match scratch.work().blob() {
+                    Some(b) => {
+                        let _ = writeln!(
+                            s,
+                            ",{},{},{},{},{},{}",
+                            b.saturated_px,
+                            b.solid_permille,
+                            b.ring_depth_permille,
+                            b.other_permille,
+                            b.sides,
+                            b.score_permille()
+                        );
+                    }
+                    None => s.push_str(",,,,,,\n"),
                 }
             }
             s
@@ -178,7 +213,7 @@ fn main() {
     } else {
         "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up,\
              perimeter,contrast_code,clutter_code,edge_sides,reach,spans,spread_code,step_mean_code,\
-             interior_cells,interior_step_code"
+             interior_cells,interior_step_code,blob_px,blob_solid,blob_ring,blob_other,blob_sides,blob_score"
             .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");

@@ -20,6 +20,8 @@
 //! background looks like (cloud texture, the limb, a real camera's shading and hot
 //! pixels) from our renders, and a cloud edge touching the target is not part of it.
 
+pub mod blob;
+mod blob_weights;
 pub mod body;
 mod cells;
 mod confidence_weights;
@@ -78,7 +80,14 @@ pub struct AutoV2 {
     /// neighbours of target cells (the same components, unless one holds no seed).
     /// Default on; off classifies every cell (the cost's worst case).
     pub prescreen: bool,
+    /// Stage 2b ([`blob`]): how the frame's largest saturated blob competes with the
+    /// cell classifier's winner. Default [`BlobRule::Compete`].
+    pub blob: BlobRule,
 }
+
+/// Relabelling step of the blob's cells when they need more labels than there are
+/// (a frame strewn with clipped pixels), pixels at the top DN per cell.
+const BLOB_RELABEL_PX: u8 = 8;
 
 impl Default for AutoV2 {
     fn default() -> Self {
@@ -89,8 +98,27 @@ impl Default for AutoV2 {
             saturated_erode_px: 2,
             body: body::BodyParams::DEFAULT,
             prescreen: true,
+            blob: BlobRule::Compete,
         }
     }
+}
+
+/// How stage 2b's saturated blob ([`blob`]) enters the decision.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BlobRule {
+    /// No blob stage: the cell classifier alone (session 26's `auto-v2`).
+    Off,
+    /// The blob is the winner when its confidence ([`blob::BlobStats::score_permille`])
+    /// reaches the gate ([`AutoV2::min_score_permille`]) and is above the classifier
+    /// winner's (0 without one); otherwise the classifier's winner stands. On family A
+    /// (famA25, paperAm, fixA) this beats taking the blob whenever it passes the gate
+    /// (summed gated mean IoU 2.027 vs 2.006; the classifier alone 1.987): a target
+    /// that saturates only in part keeps the classifier's box with its unsaturated faces.
+    Compete,
+    /// The largest blob, when the frame has one, is the winner whatever its
+    /// confidence, and the classifier does not run: the blob model's training data
+    /// (`scripts/train-auto.py --blob`).
+    Always,
 }
 
 /// What the region stage chose on the last frame (for the confidence model's
@@ -219,12 +247,28 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     hist: [u32; NOISE_BINS + 1],
     flag_row: C::Row<bool>,
     winner: Option<Winner>,
+    blob: Option<blob::BlobStats>,
+    blob_won: bool,
 }
 
 impl<C: FrameCapacity> AutoV2Work<C> {
     /// What the region stage chose on the last frame.
     pub fn winner(&self) -> Option<Winner> {
         self.winner
+    }
+
+    /// The largest saturated blob of the last frame (stage 2b), whether it won or not:
+    /// `None` when the stage is off or the frame has fewer than
+    /// [`blob::MIN_FRAME_SATURATED_PX`] pixels at the top DN.
+    pub fn blob(&self) -> Option<blob::BlobStats> {
+        self.blob
+    }
+
+    /// Whether the last frame's box (or, below the gate, its candidate) was the
+    /// saturated blob ([`Self::blob`], whose confidence it carries) rather than the
+    /// classifier's [`Self::winner`].
+    pub fn blob_won(&self) -> bool {
+        self.blob_won
     }
 }
 
@@ -247,6 +291,8 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         hist: [0; NOISE_BINS + 1],
         flag_row: ConstInit::INIT,
         winner: None,
+        blob: None,
+        blob_won: false,
     };
 }
 
@@ -284,10 +330,24 @@ fn cell_pass<C: FrameCapacity>(
     frame: &Frame<'_>,
     work: &mut AutoV2Work<C>,
     screen: bool,
-    mut code: impl FnMut(usize, usize, &[i32; FEATURES]) -> u8,
+    code: impl FnMut(usize, usize, &[i32; FEATURES]) -> u8,
 ) -> ((usize, usize), FrameLevels) {
     let win = Window::full(frame);
     let (plane, lv) = prepare(frame, work, win);
+    classify_cells(frame, work, plane, lv, screen, code);
+    (plane, lv)
+}
+
+/// Stage 3 on prepared planes ([`prepare`]): see [`cell_pass`].
+fn classify_cells<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    plane: (usize, usize),
+    lv: FrameLevels,
+    screen: bool,
+    mut code: impl FnMut(usize, usize, &[i32; FEATURES]) -> u8,
+) {
+    let win = Window::full(frame);
     let ints = Integrals {
         sum: work.sum.as_mut(),
         sum_sq: work.sum_sq.as_mut(),
@@ -319,7 +379,6 @@ fn cell_pass<C: FrameCapacity>(
         |cx, cy| !screen || prescreen::is_seed(mean_dn, step_code, ints.sum, plane, &lv, (cx, cy)),
         classify,
     );
-    (plane, lv)
 }
 
 /// Stages 1–2: noise, cell planes, levels, integrals.
@@ -360,7 +419,7 @@ fn prepare<C: FrameCapacity>(
 
 /// Logistic of a score (score units) in ‰, integer: a 33-point table of the logistic
 /// over −8…8 log-odds, linear between.
-fn logistic_permille(score: i32) -> u16 {
+pub(crate) fn logistic_permille(score: i32) -> u16 {
     const TABLE: [u16; 33] = [
         0, 1, 1, 2, 2, 4, 7, 11, 18, 29, 47, 76, 119, 182, 269, 378, 500, 622, 731, 818, 881, 924,
         953, 971, 982, 989, 993, 996, 998, 998, 999, 999, 1000,
@@ -384,10 +443,27 @@ impl AutoV2 {
             score_permille: 0,
         };
         let win = Window::full(frame);
+        // Stages 1–2: noise, cell planes, levels, integrals.
+        let (plane8, lv) = prepare(frame, work, win);
+        work.winner = None;
+        work.blob = None;
+        work.blob_won = false;
+        // Stage 2b: the frame's largest saturated blob, rated before the classifier
+        // (its labels are redone below if it wins: stage 3 reuses the planes).
+        let blob_score = match self.blob {
+            BlobRule::Off => None,
+            BlobRule::Compete | BlobRule::Always => self.blob_stage(frame, work, plane8, lv),
+        };
+        if self.blob == BlobRule::Always {
+            if let Some((winner, score_permille)) = blob_score {
+                return self.finish_blob(frame, work, plane8, lv, winner, score_permille);
+            }
+        }
+        let blob_score = blob_score.map(|(_, score)| score);
         // Stage 3: classify the cells; codes 1..=255 for target cells (the score
         // above the cell threshold, in quarter units of log-odds), 0 otherwise.
         let cell_score = i32::from(self.cell_score);
-        let (plane8, lv) = cell_pass(frame, work, self.prescreen, |_, _, feats| {
+        classify_cells(frame, work, plane8, lv, self.prescreen, |_, _, feats| {
             // The flat form of `forest_trees.rs` (built at compile time; the same
             // score as walking its nodes, `forest::score`).
             let s = forest::FLIGHT.score(feats);
@@ -410,7 +486,9 @@ impl AutoV2 {
         );
         work.winner = None;
         let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
-            return none;
+            return self
+                .blob_over(frame, work, plane8, lv, blob_score, 0)
+                .unwrap_or(none);
         };
         let (mut components, mut runner_up) = (0u16, 0u32);
         for l in 1..next {
@@ -483,9 +561,125 @@ impl AutoV2 {
             shape,
         });
         let score_permille = work.winner.map_or(0, |w| w.score_permille());
+        if let Some(d) = self.blob_over(frame, work, plane8, lv, blob_score, score_permille) {
+            return d;
+        }
         if score_permille < self.min_score_permille {
             return none;
         }
+        self.finish(frame, work, plane8, lv, (root, w8, next), score_permille)
+    }
+
+    /// [`BlobRule::Compete`]: the blob's detection when its confidence `blob_score`
+    /// reaches the gate and is above the classifier winner's `classifier_score` (‰; 0
+    /// without a winner); `None` leaves the classifier's answer standing.
+    fn blob_over<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+        blob_score: Option<u16>,
+        classifier_score: u16,
+    ) -> Option<Detection> {
+        let score = blob_score?;
+        if score < self.min_score_permille || score <= classifier_score {
+            return None;
+        }
+        // The blob's labels again (stage 3 overwrote them): the same frame, the same
+        // labels and confidence.
+        let (winner, score) = self.blob_stage(frame, work, plane8, lv)?;
+        Some(self.finish_blob(frame, work, plane8, lv, winner, score))
+    }
+
+    /// Stages 5–8 on the blob's winner; below the gate, no target.
+    fn finish_blob<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+        winner: (u8, CellStats, usize),
+        score_permille: u16,
+    ) -> Detection {
+        work.blob_won = true;
+        if score_permille < self.min_score_permille {
+            return Detection {
+                roi: None,
+                threshold: 0,
+                foreground_px: 0,
+                score_permille: 0,
+            };
+        }
+        self.finish(frame, work, plane8, lv, winner, score_permille)
+    }
+
+    /// Stage 2b ([`blob`]): the frame's largest saturated blob, its statistics in
+    /// `work.blob`, and the winner for stages 5–8 (its root label in `labels8`, its
+    /// cell statistics, one past the last label) with its confidence ‰; `None` without
+    /// a blob. Uses `labels4` (the counts), `labels8`, `comps` and `dilated4` (the
+    /// marks), which stage 3 refills.
+    fn blob_stage<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+    ) -> Option<((u8, CellStats, usize), u16)> {
+        let win = Window::full(frame);
+        let n8 = plane8.0 * plane8.1;
+        let total = blob::saturated_counts(frame, win, work.labels4.as_mut().get_mut(..n8)?);
+        if total < blob::MIN_FRAME_SATURATED_PX {
+            return None;
+        }
+        let next = label_edge_cells(
+            work.labels4.as_ref().get(..n8)?,
+            work.labels8.as_mut().get_mut(..n8)?,
+            plane8.0,
+            1,
+            BLOB_RELABEL_PX,
+            &mut work.comps,
+        );
+        let (root, w8) = choose_target(&work.comps, next, plane8, 0)?;
+        let marks = work.dilated4.as_mut().get_mut(..n8)?;
+        for (m, &l) in marks.iter_mut().zip(work.labels8.as_ref().get(..n8)?) {
+            *m = u8::from(l != 0 && work.comps.find(l) == root);
+        }
+        let marks = work.dilated4.as_ref().get(..n8)?;
+        let cell_box = (
+            usize::from(w8.x0),
+            usize::from(w8.y0),
+            usize::from(w8.x_last),
+            usize::from(w8.y_last),
+        );
+        let stats = blob::blob_stats(
+            frame,
+            win,
+            work.labels4.as_ref().get(..n8)?,
+            work.mean_dn.as_ref().get(..n8)?,
+            lv.p50,
+            total,
+            cell_box,
+            |i| marks.get(i).is_some_and(|&m| m != 0),
+        );
+        work.blob = Some(stats);
+        Some(((root, w8, next), stats.score_permille()))
+    }
+
+    /// Stages 5–8 on the winner (`root`, its cell statistics, one past the last
+    /// label) of `labels8`: `auto`'s refinement in its gate, the whole body, the half
+    /// maximum, the saturated cut.
+    fn finish<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+        (root, w8, next): (u8, CellStats, usize),
+        score_permille: u16,
+    ) -> Detection {
+        let win = Window::full(frame);
+        let n8 = plane8.0 * plane8.1;
         // Stage 5: the 4×4 gate plane from the 8×8 labels, then `auto`'s refinement.
         let plane4 = (win.w.div_ceil(4), win.h.div_ceil(4));
         let n4 = plane4.0 * plane4.1;
@@ -604,7 +798,7 @@ impl core::fmt::Display for AutoV2 {
             f,
             "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
              body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
-             body_trim_permille={} prescreen={}",
+             body_trim_permille={} prescreen={} blob={:?}",
             self.fine_sigma,
             self.cell_score,
             self.min_score_permille,
@@ -614,7 +808,8 @@ impl core::fmt::Display for AutoV2 {
             self.body.ring_to_cells,
             self.body.max_share_permille,
             self.body.trim_permille,
-            self.prescreen
+            self.prescreen,
+            self.blob
         )
     }
 }
@@ -988,6 +1183,79 @@ mod tests {
             ..det
         };
         assert!(bad.detect(&frame, &mut scratch).is_err());
+    }
+
+    /// Stage 2b end to end: a solid saturated 24×16 block in textured background is
+    /// the box under [`BlobRule::Always`] (the block itself, no cut) with the blob's
+    /// confidence; under [`BlobRule::Compete`] the answer is `Always`'s exactly when
+    /// the blob's confidence passes the gate and beats the classifier winner's (`Off`'s
+    /// winner), else `Off`'s; with and without a brighter unsaturated target elsewhere.
+    /// A ragged clipped plateau across the frame's top is rated low and not taken.
+    #[test]
+    fn a_solid_saturated_blob_wins_and_a_ragged_plateau_does_not() {
+        let bits = 12u8;
+        let top = ((1u32 << bits) - 1) as u16;
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let with = |blob| AutoV2 {
+            blob,
+            saturated_erode_px: 0,
+            ..AutoV2::default()
+        };
+        let mut outcomes = [0usize; 2];
+        for seed in [21, 23, 25] {
+            for keep_target in [true, false] {
+                let mut px = frame_pixels(seed, bits);
+                if !keep_target {
+                    px = px.iter().map(|&v| v.min(top / 4 + 200)).collect();
+                }
+                for y in 120..136 {
+                    for x in 200..224 {
+                        px[y * FRAME_WIDTH + x] = top;
+                    }
+                }
+                let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, bits).unwrap();
+                let always = with(BlobRule::Always).detect(&frame, &mut scratch).unwrap();
+                let blob = scratch.work().blob().expect("a blob");
+                assert_eq!(
+                    (blob.saturated_px, blob.solid_permille, blob.sides),
+                    (384, 1000, 0)
+                );
+                assert!(scratch.work().blob_won());
+                assert_eq!(always.score_permille, blob.score_permille());
+                assert_eq!(always.roi, Some(Roi::new(200, 120, 224, 136)));
+                let off = with(BlobRule::Off).detect(&frame, &mut scratch).unwrap();
+                assert!(scratch.work().blob().is_none() && !scratch.work().blob_won());
+                let classifier = scratch.work().winner().map_or(0, |w| w.score_permille());
+                let compete = with(BlobRule::Compete)
+                    .detect(&frame, &mut scratch)
+                    .unwrap();
+                let wins = blob.score_permille() >= AutoV2::default().min_score_permille
+                    && blob.score_permille() > classifier;
+                assert_eq!(scratch.work().blob_won(), wins);
+                assert_eq!(compete, if wins { always } else { off });
+                outcomes[usize::from(wins)] += 1;
+            }
+        }
+        // Both outcomes happen: the bright target beats the blob, alone the blob wins.
+        assert!(outcomes[0] > 0 && outcomes[1] > 0, "{outcomes:?}");
+        // A clipped plateau along the top edge, full of holes: rated low, not taken.
+        let mut px = frame_pixels(22, bits);
+        for y in 0..24 {
+            for x in 0..FRAME_WIDTH {
+                if (x * 7 + y * 3) % 5 != 0 {
+                    px[y * FRAME_WIDTH + x] = top;
+                }
+            }
+        }
+        let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, bits).unwrap();
+        let d = AutoV2::default().detect(&frame, &mut scratch).unwrap();
+        let blob = scratch.work().blob().expect("a blob");
+        assert!(blob.solid_permille < 900 && blob.sides >= 3, "{blob:?}");
+        assert!(
+            blob.score_permille() < AutoV2::default().min_score_permille,
+            "{blob:?}"
+        );
+        assert!(!scratch.work().blob_won(), "{d:?}");
     }
 
     #[test]
