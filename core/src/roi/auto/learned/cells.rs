@@ -22,6 +22,10 @@ pub struct CellPlanes<'a> {
     /// Largest |v(x+1) − v(x−1)| or |v(y+1) − v(y−1)| of the cell's pixels, as
     /// [`super::features::log_code`] of 4 · step / σ.
     pub step_code: &'a mut [u8],
+    /// Pixels of the cell at or above the frame's top DN (0..=64): the saturated blob's
+    /// counts ([`super::blob`]), counted in the same pass (on the M7 a separate pass
+    /// cost 15 instructions per pixel, this one about 2).
+    pub saturated_px: &'a mut [u8],
 }
 
 /// Fills the cell planes of `win`. `sums` holds one cell row of running sums
@@ -47,25 +51,40 @@ pub fn fill_cells(
         sums.fill(0);
         let step_row = &mut *steps;
         step_row.fill(0);
+        // This cell row's saturated counts (`get_mut`: an empty row, never a panic
+        // path, if the plane were short).
+        let sat_row = planes
+            .saturated_px
+            .get_mut(cy * pw..(cy + 1) * pw)
+            .unwrap_or_default();
+        sat_row.fill(0);
         for y in ya..yb {
             let Some(row) = frame.row(y) else { continue };
             let row = &row[..fw];
             let up = frame.row(y.saturating_sub(1)).map(|r| &r[..fw]);
             let down = frame.row((y + 1).min(fh - 1)).map(|r| &r[..fw]);
-            for (cx, (s, st)) in sums.iter_mut().zip(step_row.iter_mut()).enumerate() {
+            for (cx, ((s, st), sat)) in sums
+                .iter_mut()
+                .zip(step_row.iter_mut())
+                .zip(sat_row.iter_mut())
+                .enumerate()
+            {
                 let xa = x0 + cx * CELL_PX;
                 let xb = (xa + CELL_PX).min(x0 + w);
                 // An inner cell (a pixel on each side, both neighbouring rows): the same
                 // sums and steps from slices, without a bounds check per read.
                 if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
-                    let (acc, best) = inner_cell(row, u, d, xa, xb, max_dn, *st);
+                    let (acc, best, n_sat) = inner_cell(row, u, d, xa, xb, max_dn, *st);
                     *s += acc;
                     *st = best;
+                    *sat = sat.saturating_add(n_sat);
                     continue;
                 }
                 let mut acc = 0u32;
                 let mut best = *st;
+                let mut n_sat = 0u8;
                 for x in xa..xb {
+                    n_sat += u8::from(row[x] >= max_dn);
                     let v = row[x].min(max_dn);
                     acc += u32::from(v);
                     let l = row[x.saturating_sub(1)].min(max_dn);
@@ -79,6 +98,7 @@ pub fn fill_cells(
                 }
                 *s += acc;
                 *st = best;
+                *sat = sat.saturating_add(n_sat);
             }
         }
         // `get_mut`: the planes hold pw·ph cells (the caller's slices), so the row is
@@ -109,11 +129,12 @@ pub fn fill_cells(
     }
 }
 
-/// The sum of pixels `xa..xb` of `row` (clamped to `max_dn`) and the largest of `best`
+/// The sum of pixels `xa..xb` of `row` (clamped to `max_dn`), the largest of `best`
 /// and their two-pixel steps, across (`row[x − 1]` to `row[x + 1]`) and down (`up[x]` to
-/// `down[x]`), for `1 ≤ xa` and `xb < row.len()` (an inner cell: every neighbour in the
-/// row); `fill_cells`'s per-pixel loop without its edge clamps. Slices out of range (never,
-/// by the caller's test) give `(0, best)`.
+/// `down[x]`), and how many are at or above `max_dn`, for `1 ≤ xa` and `xb < row.len()`
+/// (an inner cell: every neighbour in the row; `xb − xa` ≤ 8); `fill_cells`'s per-pixel
+/// loop without its edge clamps. Slices out of range (never, by the caller's test) give
+/// `(0, best, 0)`.
 #[inline(always)]
 fn inner_cell(
     row: &[u16],
@@ -123,7 +144,7 @@ fn inner_cell(
     xb: usize,
     max_dn: u16,
     best: u16,
-) -> (u32, u16) {
+) -> (u32, u16, u8) {
     let (Some(left), Some(mid), Some(right), Some(up), Some(down)) = (
         row.get(xa.wrapping_sub(1)..xb.wrapping_sub(1)),
         row.get(xa..xb),
@@ -131,17 +152,19 @@ fn inner_cell(
         up.get(xa..xb),
         down.get(xa..xb),
     ) else {
-        return (0, best);
+        return (0, best, 0);
     };
     let mut acc = 0u32;
     let mut best = best;
+    let mut n_sat = 0u8;
     for ((((&l, &v), &r), &u), &d) in left.iter().zip(mid).zip(right).zip(up).zip(down) {
+        n_sat += u8::from(v >= max_dn);
         acc += u32::from(v.min(max_dn));
         let h = l.min(max_dn).abs_diff(r.min(max_dn));
         let vert = u.min(max_dn).abs_diff(d.min(max_dn));
         best = best.max(h).max(vert);
     }
-    (acc, best)
+    (acc, best, n_sat)
 }
 
 /// Side of the finer windows the classifier also looks through, pixels: a 3–12 px far
@@ -228,8 +251,9 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
-    /// The cell plane against a brute force over the pixels (sum and the largest
-    /// clamped two-pixel step across and down, neighbours clamped at the frame's edges)
+    /// The cell plane against a brute force over the pixels (sum, the largest clamped
+    /// two-pixel step across and down, neighbours clamped at the frame's edges, and the
+    /// pixels at or above the top DN)
     /// on frames of odd sizes (partial cells on the right and bottom), values above the
     /// bit depth's top DN, and the full reference size.
     #[test]
@@ -254,6 +278,7 @@ mod tests {
             let (pw, ph) = cell_plane(win);
             let sigma = 7u32;
             let (mut mean, mut code) = (std::vec![0u16; pw * ph], std::vec![0u8; pw * ph]);
+            let mut sat = std::vec![0xAAu8; pw * ph];
             let (mut sums, mut steps) = (std::vec![0u32; pw], std::vec![0u16; pw]);
             fill_cells(
                 &frame,
@@ -262,6 +287,7 @@ mod tests {
                 CellPlanes {
                     mean_dn: &mut mean,
                     step_code: &mut code,
+                    saturated_px: &mut sat,
                 },
                 &mut sums,
                 &mut steps,
@@ -270,11 +296,12 @@ mod tests {
             let at = |x: usize, y: usize| px[y * w + x].min(top);
             for cy in 0..ph {
                 for cx in 0..pw {
-                    let (mut s, mut n, mut best) = (0u64, 0u64, 0u16);
+                    let (mut s, mut n, mut best, mut n_sat) = (0u64, 0u64, 0u16, 0u8);
                     for y in cy * 8..(cy * 8 + 8).min(h) {
                         for x in cx * 8..(cx * 8 + 8).min(w) {
                             s += u64::from(at(x, y));
                             n += 1;
+                            n_sat += u8::from(px[y * w + x] >= top);
                             let across =
                                 at(x.saturating_sub(1), y).abs_diff(at((x + 1).min(w - 1), y));
                             let down =
@@ -284,6 +311,7 @@ mod tests {
                     }
                     let i = cy * pw + cx;
                     assert_eq!(u64::from(mean[i]), s / n, "{w}x{h} cell ({cx}, {cy})");
+                    assert_eq!(sat[i], n_sat, "{w}x{h} saturated ({cx}, {cy})");
                     let want = super::super::features::log_code(u32::from(best) * 4 / sigma);
                     assert_eq!(
                         i32::from(code[i]),

@@ -85,6 +85,15 @@ pub struct AutoV2 {
     pub blob: BlobRule,
 }
 
+/// Where stage 2b finds the saturated counts per cell in `labels4`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Counts {
+    /// As [`prepare`] left them (the cell planes' pass counted them).
+    FromPrepare,
+    /// Overwritten by stage 3: counted again ([`blob::saturated_counts`]).
+    Recount,
+}
+
 /// Relabelling step of the blob's cells when they need more labels than there are
 /// (a frame strewn with clipped pixels), pixels at the top DN per cell.
 const BLOB_RELABEL_PX: u8 = 8;
@@ -397,6 +406,8 @@ fn prepare<C: FrameCapacity>(
         CellPlanes {
             mean_dn: &mut work.mean_dn.as_mut()[..n],
             step_code: &mut work.step_code.as_mut()[..n],
+            // Free until stage 3 (its codes): the saturated blob reads them first.
+            saturated_px: &mut work.labels4.as_mut()[..n],
         },
         work.cell_sums.as_mut(),
         work.col_sat.as_mut(),
@@ -452,7 +463,9 @@ impl AutoV2 {
         // (its labels are redone below if it wins: stage 3 reuses the planes).
         let blob_score = match self.blob {
             BlobRule::Off => None,
-            BlobRule::Compete | BlobRule::Always => self.blob_stage(frame, work, plane8, lv),
+            BlobRule::Compete | BlobRule::Always => {
+                self.blob_stage(frame, work, plane8, lv, Counts::FromPrepare)
+            }
         };
         if self.blob == BlobRule::Always {
             if let Some((winner, score_permille)) = blob_score {
@@ -588,7 +601,7 @@ impl AutoV2 {
         }
         // The blob's labels again (stage 3 overwrote them): the same frame, the same
         // labels and confidence.
-        let (winner, score) = self.blob_stage(frame, work, plane8, lv)?;
+        let (winner, score) = self.blob_stage(frame, work, plane8, lv, Counts::Recount)?;
         Some(self.finish_blob(frame, work, plane8, lv, winner, score))
     }
 
@@ -617,18 +630,23 @@ impl AutoV2 {
     /// Stage 2b ([`blob`]): the frame's largest saturated blob, its statistics in
     /// `work.blob`, and the winner for stages 5–8 (its root label in `labels8`, its
     /// cell statistics, one past the last label) with its confidence ‰; `None` without
-    /// a blob. Uses `labels4` (the counts), `labels8`, `comps` and `dilated4` (the
-    /// marks), which stage 3 refills.
+    /// a blob. Uses `labels4` (the saturated counts, [`Counts`]), `labels8`, `comps`
+    /// and `dilated4` (the marks), which stage 3 refills.
     fn blob_stage<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoV2Work<C>,
         plane8: (usize, usize),
         lv: FrameLevels,
+        counts: Counts,
     ) -> Option<((u8, CellStats, usize), u16)> {
         let win = Window::full(frame);
         let n8 = plane8.0 * plane8.1;
-        let total = blob::saturated_counts(frame, win, work.labels4.as_mut().get_mut(..n8)?);
+        let plane = work.labels4.as_mut().get_mut(..n8)?;
+        let total = match counts {
+            Counts::FromPrepare => plane.iter().map(|&c| u32::from(c)).sum(),
+            Counts::Recount => blob::saturated_counts(frame, win, plane),
+        };
         if total < blob::MIN_FRAME_SATURATED_PX {
             return None;
         }
@@ -683,9 +701,22 @@ impl AutoV2 {
         // Stage 5: the 4×4 gate plane from the 8×8 labels, then `auto`'s refinement.
         let plane4 = (win.w.div_ceil(4), win.h.div_ceil(4));
         let n4 = plane4.0 * plane4.1;
+        // The planes hold the frame's cells (`prepare` sized them); called from three
+        // places, this is not inlined where that is known, so every plane is taken
+        // with `get` (no panic path): a short plane would mean no target.
+        let no_target = Detection {
+            roi: None,
+            threshold: 0,
+            foreground_px: 0,
+            score_permille: 0,
+        };
         {
-            let labels4 = &mut work.labels4.as_mut()[..n4];
-            let labels8 = &work.labels8.as_ref()[..n8];
+            let (Some(labels4), Some(labels8)) = (
+                work.labels4.as_mut().get_mut(..n4),
+                work.labels8.as_ref().get(..n8),
+            ) else {
+                return no_target;
+            };
             for (cy, row) in labels4.chunks_exact_mut(plane4.0).enumerate() {
                 for (cx, l) in row.iter_mut().enumerate() {
                     // Every 4×4 cell lies in an 8×8 one (`get`: no panic path).
@@ -705,9 +736,15 @@ impl AutoV2 {
             ..w8
         };
         let region = Region::around(&w4, win);
+        let (Some(gate_labels), Some(gate_dilated)) = (
+            work.labels4.as_mut().get_mut(..n4),
+            work.dilated4.as_mut().get_mut(..n4),
+        ) else {
+            return no_target;
+        };
         let gate = build_gate(
-            &mut work.labels4.as_mut()[..n4],
-            &mut work.dilated4.as_mut()[..n4],
+            gate_labels,
+            gate_dilated,
             work.flag_row.as_mut(),
             &mut work.comps,
             root,
@@ -760,23 +797,21 @@ impl AutoV2 {
             if saturated::is_saturated_blob(frame, r) {
                 return r;
             }
-            let marks = &mut work.labels4.as_mut()[..n8];
-            for (m, &l) in marks.iter_mut().zip(&work.labels8.as_ref()[..n8]) {
+            let (Some(marks), Some(labels8), Some(mean_dn)) = (
+                work.labels4.as_mut().get_mut(..n8),
+                work.labels8.as_ref().get(..n8),
+                work.mean_dn.as_ref().get(..n8),
+            ) else {
+                return r;
+            };
+            for (m, &l) in marks.iter_mut().zip(labels8) {
                 *m = if l != 0 && work.comps.find(l) == root {
                     body::WINNER
                 } else {
                     0
                 };
             }
-            body::body_box(
-                frame,
-                &work.mean_dn.as_ref()[..n8],
-                marks,
-                plane8,
-                lv.sigma,
-                r,
-                self.body,
-            )
+            body::body_box(frame, mean_dn, marks, plane8, lv.sigma, r, self.body)
         });
         // Stage 7: small boxes cut to their half maximum (far targets' blur).
         let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
