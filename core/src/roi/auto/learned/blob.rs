@@ -137,8 +137,10 @@ pub(crate) fn blob_stats(
     let (bx0, by0, bx1, by1) = cell_box;
     let mut saturated_px = 0u32;
     let (mut ring_sum, mut ring_n) = (0u64, 0u64);
-    for cy in 0..ph {
-        for cx in 0..pw {
+    // The blob's cells lie in its box and its ring in the box grown by one cell: only
+    // those cells are visited (a hot pixel's blob costs a few cells, not the plane).
+    for cy in by0.saturating_sub(1)..=(by1 + 1).min(ph.saturating_sub(1)) {
+        for cx in bx0.saturating_sub(1)..=(bx1 + 1).min(pw.saturating_sub(1)) {
             let i = cy * pw + cx;
             if is_member(i) {
                 saturated_px += u32::from(counts.get(i).copied().unwrap_or(0));

@@ -717,7 +717,7 @@ impl AutoV2 {
             ) else {
                 return no_target;
             };
-            for (cy, row) in labels4.chunks_exact_mut(plane4.0).enumerate() {
+            for (cy, row) in labels4.chunks_exact_mut(plane4.0.max(1)).enumerate() {
                 for (cx, l) in row.iter_mut().enumerate() {
                     // Every 4×4 cell lies in an 8×8 one (`get`: no panic path).
                     *l = labels8
