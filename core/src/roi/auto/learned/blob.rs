@@ -184,11 +184,8 @@ pub(crate) fn blob_stats(
         }
     }
     let solid_permille = (inside * 1000 / span.max(1)).min(1000) as u16;
-    let ring_mean = if ring_n == 0 {
-        u64::from(top)
-    } else {
-        ring_sum / ring_n
-    };
+    // Without a ring (the blob fills the frame), the ring is at the top: depth 0.
+    let ring_mean = ring_sum.checked_div(ring_n).unwrap_or(u64::from(top));
     let depth = u64::from(top).saturating_sub(ring_mean);
     let median_depth = u64::from(top.saturating_sub(p50)).max(1);
     let ring_depth_permille = (depth * 1000 / median_depth).min(2000) as u16;
