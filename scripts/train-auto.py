@@ -268,12 +268,15 @@ def confidence(out, pairs):
 # truth (0.5-coverage convention); a logistic regression of hit on the blob's integer
 # features (`BlobStats::features`) gives integer weights (4096 per unit).
 
-BLOB_FEATURES = ["log_px", "solid_permille", "ring_depth_permille", "log_other_permille", "sides"]
+BLOB_FEATURES = ["log_px", "solid_permille", "ring_depth_permille", "log_other_permille", "sides",
+                 "many_sides"]
+MANY_SIDES = 3  # `learned::blob::MANY_SIDES`
 
 
 def blob_features(r):
+    sides = int(r["blob_sides"])
     return [log_code(int(r["blob_px"]) - 1), int(r["blob_solid"]), int(r["blob_ring"]),
-            log_code(int(r["blob_other"])), int(r["blob_sides"])]
+            log_code(int(r["blob_other"])), sides, int(sides >= MANY_SIDES)]
 
 
 def blob_rows(pred, dataset):

@@ -35,7 +35,16 @@ const CELL_PX: usize = 8;
 pub const MIN_FRAME_SATURATED_PX: u32 = super::saturated::MIN_BLOB_PX;
 
 /// Number of the blob model's features ([`BlobStats::features`]).
-pub const BLOB_FEATURES: usize = 5;
+pub const BLOB_FEATURES: usize = 6;
+
+// The generated weights match the features (a retrain with another count fails here).
+const _: () = assert!(blob_weights::WEIGHTS.len() == BLOB_FEATURES);
+
+/// From this many sides touched a blob is rated as its own class
+/// ([`BlobStats::features`]): on family A no realistic blob touching 3 or 4 sides was a
+/// hit (0 of 65: the Earth's disc clipped at the top DN), but the sides' linear weight
+/// alone let a large enough one pass (its size's weight outgrew it).
+pub const MANY_SIDES: u8 = 3;
 
 /// Statistics of the largest saturated blob of a frame (the blob model's inputs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -59,7 +68,7 @@ pub struct BlobStats {
 impl BlobStats {
     /// The blob model's integer features: log code of the saturated pixels − 1, the
     /// solidity ‰, the ring's depth ‰, log code of the other saturated pixels ‰, the
-    /// sides touched.
+    /// sides touched, and 1 from [`MANY_SIDES`] sides (else 0).
     pub fn features(&self) -> [i32; BLOB_FEATURES] {
         [
             log_code(self.saturated_px.saturating_sub(1)),
@@ -67,6 +76,7 @@ impl BlobStats {
             i32::from(self.ring_depth_permille),
             log_code(self.other_permille),
             i32::from(self.sides),
+            i32::from(self.sides >= MANY_SIDES),
         ]
     }
 
@@ -309,7 +319,8 @@ mod tests {
     }
 
     /// The model's features are the statistics as documented, and its confidence is
-    /// a logistic: a solid blob in the background rates above a ragged one on a side.
+    /// a logistic: a solid blob in the background rates above even odds, a ragged one on
+    /// two sides (family A's median miss) and the Earth's disc on three below.
     #[test]
     fn the_confidence_ranks_a_solid_blob_above_a_ragged_plateau() {
         let solid = BlobStats {
@@ -326,9 +337,20 @@ mod tests {
             other_permille: 2,
             sides: 2,
         };
-        assert_eq!(solid.features()[1..], [1000, 1000, log_code(0), 0]);
+        assert_eq!(solid.features()[1..], [1000, 1000, log_code(0), 0, 0]);
+        // Three sides: the many-sides term as well; a large solid blob touching three
+        // sides (the Earth's disc clipped) is rated below even odds.
+        let disc = BlobStats {
+            saturated_px: 44_707,
+            solid_permille: 931,
+            ring_depth_permille: 2000,
+            other_permille: 1,
+            sides: 3,
+        };
+        assert_eq!(disc.features()[4..], [3, 1]);
+        assert!(disc.score_permille() < 500, "{}", disc.score_permille());
         assert!(solid.score_permille() > 800, "{}", solid.score_permille());
-        assert!(ragged.score_permille() < 200, "{}", ragged.score_permille());
+        assert!(ragged.score_permille() < 500, "{}", ragged.score_permille());
         assert!(solid.score_permille() <= 1000);
     }
 }
