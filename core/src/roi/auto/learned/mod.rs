@@ -85,6 +85,14 @@ pub struct AutoV2 {
     pub blob: BlobRule,
 }
 
+/// The answer "no target": no box, confidence 0.
+const NO_TARGET: Detection = Detection {
+    roi: None,
+    threshold: 0,
+    foreground_px: 0,
+    score_permille: 0,
+};
+
 /// Where stage 2b finds the saturated counts per cell in `labels4`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Counts {
@@ -447,12 +455,7 @@ pub(crate) fn logistic_permille(score: i32) -> u16 {
 
 impl AutoV2 {
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
-        let none = Detection {
-            roi: None,
-            threshold: 0,
-            foreground_px: 0,
-            score_permille: 0,
-        };
+        let none = NO_TARGET;
         let win = Window::full(frame);
         // Stages 1–2: noise, cell planes, levels, integrals.
         let (plane8, lv) = prepare(frame, work, win);
@@ -617,12 +620,7 @@ impl AutoV2 {
     ) -> Detection {
         work.blob_won = true;
         if score_permille < self.min_score_permille {
-            return Detection {
-                roi: None,
-                threshold: 0,
-                foreground_px: 0,
-                score_permille: 0,
-            };
+            return NO_TARGET;
         }
         self.finish(frame, work, plane8, lv, winner, score_permille)
     }
@@ -704,12 +702,7 @@ impl AutoV2 {
         // The planes hold the frame's cells (`prepare` sized them); called from three
         // places, this is not inlined where that is known, so every plane is taken
         // with `get` (no panic path): a short plane would mean no target.
-        let no_target = Detection {
-            roi: None,
-            threshold: 0,
-            foreground_px: 0,
-            score_permille: 0,
-        };
+        let no_target = NO_TARGET;
         {
             let (Some(labels4), Some(labels8)) = (
                 work.labels4.as_mut().get_mut(..n4),
