@@ -22,13 +22,10 @@
 //! detection-far 0.604 → 0.644; `docs/detectors.md` § session 27 has every set.
 
 use super::blob_weights;
+use super::cells::{CELL_PX, cell_plane};
 use super::features::log_code;
-use super::forest::SCORE_ONE;
 use crate::frame::Frame;
 use crate::roi::plane::Window;
-
-/// Side of a cell, px (the classifier's 8×8 cells).
-const CELL_PX: usize = 8;
 
 /// Fewest pixels at the top DN in the frame for the stage to run: a 2×2 core (hot
 /// pixels come alone), as [`super::saturated::MIN_BLOB_PX`].
@@ -83,15 +80,11 @@ impl BlobStats {
     /// P(hit) of the blob as the winner, ‰: the logistic of the fitted weights
     /// (`blob_weights.rs`, 4096 per unit of log-odds) over [`Self::features`].
     pub fn score_permille(&self) -> u16 {
-        let z = self
-            .features()
-            .iter()
-            .zip(blob_weights::WEIGHTS)
-            .fold(i64::from(blob_weights::BIAS), |z, (&f, w)| {
-                z + i64::from(f) * i64::from(w)
-            });
-        let units = i64::from(SCORE_ONE);
-        super::logistic_permille((z * units / 4096).clamp(-(1 << 20), 1 << 20) as i32)
+        super::weighted_logistic_permille(
+            &self.features(),
+            &blob_weights::WEIGHTS,
+            blob_weights::BIAS,
+        )
     }
 }
 
@@ -100,8 +93,8 @@ impl BlobStats {
 /// beyond `counts` are not counted (no panic path).
 pub(crate) fn saturated_counts(frame: &Frame<'_>, win: Window, counts: &mut [u8]) -> u32 {
     let top = frame.max_dn();
-    let pw = win.w.div_ceil(CELL_PX);
-    let n = pw * win.h.div_ceil(CELL_PX);
+    let (pw, ph) = cell_plane(win);
+    let n = pw * ph;
     let counts = match counts.get_mut(..n) {
         Some(c) => c,
         None => return 0,
@@ -142,7 +135,7 @@ pub(crate) fn blob_stats(
     cell_box: (usize, usize, usize, usize),
     is_member: impl Fn(usize) -> bool,
 ) -> BlobStats {
-    let (pw, ph) = (win.w.div_ceil(CELL_PX), win.h.div_ceil(CELL_PX));
+    let (pw, ph) = cell_plane(win);
     let top = frame.max_dn();
     let (bx0, by0, bx1, by1) = cell_box;
     let mut saturated_px = 0u32;
@@ -184,13 +177,17 @@ pub(crate) fn blob_stats(
         let Some(row) = frame.row(y).and_then(|r| r.get(x_from..x_to)) else {
             continue;
         };
-        let first = row.iter().position(|&v| v >= top);
-        let last = row.iter().rposition(|&v| v >= top);
-        if let (Some(a), Some(b)) = (first, last) {
-            span += (b - a + 1) as u64;
-            inside +=
-                row.get(a..=b)
-                    .map_or(0, |r| r.iter().filter(|&&v| v >= top).count()) as u64;
+        // One scan: the row's saturated pixels, the first and the last of them (all
+        // of them lie between).
+        let (mut n, mut first, mut last) = (0u64, usize::MAX, 0usize);
+        for (x, _) in row.iter().enumerate().filter(|&(_, &v)| v >= top) {
+            n += 1;
+            first = first.min(x);
+            last = x;
+        }
+        if n > 0 {
+            span += (last - first + 1) as u64;
+            inside += n;
         }
     }
     let solid_permille = (inside * 1000 / span.max(1)).min(1000) as u16;

@@ -229,16 +229,11 @@ impl Winner {
     /// weights (`confidence_weights.rs`, 4096 per unit of log-odds) over
     /// [`Self::confidence_features`].
     pub fn score_permille(&self) -> u16 {
-        let z = self
-            .confidence_features()
-            .iter()
-            .zip(confidence_weights::WEIGHTS)
-            .fold(i64::from(confidence_weights::BIAS), |z, (&f, w)| {
-                z + i64::from(f) * i64::from(w)
-            });
-        // 4096 per unit of log-odds → score units (256 per unit).
-        let units = forest::SCORE_ONE as i64;
-        logistic_permille((z * units / 4096).clamp(-(1 << 20), 1 << 20) as i32)
+        weighted_logistic_permille(
+            &self.confidence_features(),
+            &confidence_weights::WEIGHTS,
+            confidence_weights::BIAS,
+        )
     }
 }
 
@@ -436,9 +431,24 @@ fn prepare<C: FrameCapacity>(
     (plane, lv)
 }
 
+/// A fitted logistic model's P, ‰: the logistic of `bias + Σ feature · weight`, weights
+/// and bias in 4096 per unit of log-odds (`scripts/train-auto.py`'s scale), as the
+/// confidence of the classifier's winner and of the saturated blob use it.
+pub(crate) fn weighted_logistic_permille(features: &[i32], weights: &[i32], bias: i32) -> u16 {
+    let z = features
+        .iter()
+        .zip(weights)
+        .fold(i64::from(bias), |z, (&f, &w)| {
+            z + i64::from(f) * i64::from(w)
+        });
+    // 4096 per unit of log-odds → score units (256 per unit).
+    let units = i64::from(forest::SCORE_ONE);
+    logistic_permille((z * units / 4096).clamp(-(1 << 20), 1 << 20) as i32)
+}
+
 /// Logistic of a score (score units) in ‰, integer: a 33-point table of the logistic
 /// over −8…8 log-odds, linear between.
-pub(crate) fn logistic_permille(score: i32) -> u16 {
+fn logistic_permille(score: i32) -> u16 {
     const TABLE: [u16; 33] = [
         0, 1, 1, 2, 2, 4, 7, 11, 18, 29, 47, 76, 119, 182, 269, 378, 500, 622, 731, 818, 881, 924,
         953, 971, 982, 989, 993, 996, 998, 998, 999, 999, 1000,
@@ -455,7 +465,6 @@ pub(crate) fn logistic_permille(score: i32) -> u16 {
 
 impl AutoV2 {
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
-        let none = NO_TARGET;
         let win = Window::full(frame);
         // Stages 1–2: noise, cell planes, levels, integrals.
         let (plane8, lv) = prepare(frame, work, win);
@@ -504,7 +513,7 @@ impl AutoV2 {
         let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
             return self
                 .blob_over(frame, work, plane8, lv, blob_score, 0)
-                .unwrap_or(none);
+                .unwrap_or(NO_TARGET);
         };
         let (mut components, mut runner_up) = (0u16, 0u32);
         for l in 1..next {
@@ -581,7 +590,7 @@ impl AutoV2 {
             return d;
         }
         if score_permille < self.min_score_permille {
-            return none;
+            return NO_TARGET;
         }
         self.finish(frame, work, plane8, lv, (root, w8, next), score_permille)
     }
@@ -702,13 +711,12 @@ impl AutoV2 {
         // The planes hold the frame's cells (`prepare` sized them); called from three
         // places, this is not inlined where that is known, so every plane is taken
         // with `get` (no panic path): a short plane would mean no target.
-        let no_target = NO_TARGET;
         {
             let (Some(labels4), Some(labels8)) = (
                 work.labels4.as_mut().get_mut(..n4),
                 work.labels8.as_ref().get(..n8),
             ) else {
-                return no_target;
+                return NO_TARGET;
             };
             for (cy, row) in labels4.chunks_exact_mut(plane4.0.max(1)).enumerate() {
                 for (cx, l) in row.iter_mut().enumerate() {
@@ -733,7 +741,7 @@ impl AutoV2 {
             work.labels4.as_mut().get_mut(..n4),
             work.dilated4.as_mut().get_mut(..n4),
         ) else {
-            return no_target;
+            return NO_TARGET;
         };
         let gate = build_gate(
             gate_labels,
