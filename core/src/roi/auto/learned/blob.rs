@@ -177,17 +177,17 @@ pub(crate) fn blob_stats(
         let Some(row) = frame.row(y).and_then(|r| r.get(x_from..x_to)) else {
             continue;
         };
-        // One scan: the row's saturated pixels, the first and the last of them (all
-        // of them lie between).
-        let (mut n, mut first, mut last) = (0u64, usize::MAX, 0usize);
-        for (x, _) in row.iter().enumerate().filter(|&(_, &v)| v >= top) {
-            n += 1;
-            first = first.min(x);
-            last = x;
-        }
-        if n > 0 {
-            span += (last - first + 1) as u64;
-            inside += n;
+        // The first and the last saturated pixel from either end (each scan stops
+        // there), then the count between them, where all of the row's lie: on the
+        // M7 this is cheaper than one scan that updates all three per pixel
+        // (`holes-3`, a whole-frame blob: 34.14 M against 35.22 M per call).
+        let first = row.iter().position(|&v| v >= top);
+        let last = row.iter().rposition(|&v| v >= top);
+        if let (Some(a), Some(b)) = (first, last) {
+            span += (b - a + 1) as u64;
+            inside +=
+                row.get(a..=b)
+                    .map_or(0, |r| r.iter().filter(|&&v| v >= top).count()) as u64;
         }
     }
     let solid_permille = (inside * 1000 / span.max(1)).min(1000) as u16;
