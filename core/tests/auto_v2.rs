@@ -2,8 +2,8 @@
 //! depth and random parameters within bounds it never panics and answers `Ok`; its box
 //! is non-empty and inside the frame; its confidence is in 0..=1000 ‰, at least the
 //! threshold for a box and 0 for `null`; the threshold cuts exactly at the confidence
-//! (`null` from one ‰ above it, the same box at it); the same frame gives the same
-//! answer twice, in the same scratch and in a fresh one; and through the registry
+//! (`null` from one ‰ above it without a tracking prior, the same box at it); the same
+//! frame gives the same answer twice, with or without a prior, in the same scratch and in a fresh one; and through the registry
 //! (`Method::AutoV2`) it answers as called directly. Parameters out of bounds are an
 //! error, never a panic.
 //!
@@ -21,7 +21,7 @@ use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
 use tirroi_core::roi::{Detectors, Params};
-use tirroi_core::{DetectError, Detector, Frame, Method, SCORE_FULL_PERMILLE};
+use tirroi_core::{DetectError, Detector, Frame, Method, Roi, SCORE_FULL_PERMILLE};
 
 /// `cases` cases from a fixed seed (unless `PROPTEST_RNG_SEED` is set).
 fn config(cases: u32) -> ProptestConfig {
@@ -48,6 +48,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
             Just(BlobRule::Off),
             Just(BlobRule::Always)
         ],
+        prior(),
     )
         .prop_map(
             |(
@@ -58,8 +59,10 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 body,
                 prescreen,
                 blob,
+                prior,
             )| {
                 AutoV2 {
+                    prior,
                     fine_sigma,
                     cell_score,
                     min_score_permille,
@@ -70,6 +73,14 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 }
             },
         )
+}
+
+/// A tracking prior: none (weighted in), or any box, also empty, reversed or off the
+/// frame (it is cut to the frame; an empty result is no prior).
+fn prior() -> impl Strategy<Value = Option<Roi>> {
+    let any = (0u16..400, 0u16..300, 0u16..400, 0u16..300)
+        .prop_map(|(x0, y0, x1, y1)| Some(Roi { x0, y0, x1, y1 }));
+    prop_oneof![2 => Just(None), 1 => any]
 }
 
 /// The body stage's parameters within their documented bounds (`BodyParams::is_valid`),
@@ -148,7 +159,9 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 ..det
             };
             prop_assert_eq!(at.detect(&f, &mut scratch).unwrap(), d);
-            if d.score_permille < SCORE_FULL_PERMILLE {
+            // Without a prior: with one, a box gated in the tracking window sends the
+            // search to the whole frame, whose winner may pass the stricter gate.
+            if d.score_permille < SCORE_FULL_PERMILLE && det.prior.is_none() {
                 let above = AutoV2 {
                     min_score_permille: d.score_permille + 1,
                     ..det

@@ -7,14 +7,16 @@
 //! depth − 1 (mod 16), byte 3 `fine_sigma` − 1 (mod 40), bytes 4..6 `cell_score`
 //! (little-endian i16, mod 8193 − 4096), bytes 6..8 `min_score_permille` (little-endian
 //! u16, mod 1001), byte 8 `saturated_erode_px` (mod 9) and, by its top bit, the body
-//! stage on (`BodyParams::DEFAULT`) or off, the rest the DN (little-endian
-//! u16, repeated to fill the frame; none: a black frame).
+//! stage on (`BodyParams::DEFAULT`) or off; when byte 2's top bit is set, bytes 9..17
+//! a tracking prior (x0, y0, x1, y1, little-endian u16: any box, cut to the frame by
+//! the detector); the rest the DN (little-endian u16, repeated to fill the frame;
+//! none: a black frame).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
-use tirroi_core::{Detector, Frame, SCORE_FULL_PERMILLE};
+use tirroi_core::{Detector, Frame, Roi, SCORE_FULL_PERMILLE};
 
 fuzz_target!(|data: &[u8]| {
     if data.len() < 9 {
@@ -23,7 +25,14 @@ fuzz_target!(|data: &[u8]| {
     let w = 1 + usize::from(data[0]) % 328;
     let h = 1 + usize::from(data[1]) % 248;
     let bits = 1 + data[2] % 16;
+    let word = |i: usize| u16::from_le_bytes([data[i], data[i + 1]]);
+    let (prior, dn_from) = if data[2] & 0x80 != 0 && data.len() >= 17 {
+        (Some(Roi::new(word(9), word(11), word(13), word(15))), 17)
+    } else {
+        (None, 9)
+    };
     let det = AutoV2 {
+        prior,
         fine_sigma: 1 + u16::from(data[3] % 40),
         cell_score: (i32::from(i16::from_le_bytes([data[4], data[5]])).rem_euclid(8193) - 4096)
             as i16,
@@ -41,7 +50,7 @@ fuzz_target!(|data: &[u8]| {
             _ => BlobRule::Compete,
         },
     };
-    let dn: Vec<u16> = data[9..]
+    let dn: Vec<u16> = data[dn_from..]
         .chunks_exact(2)
         .map(|c| u16::from_le_bytes([c[0], c[1]]))
         .collect();
@@ -60,8 +69,10 @@ fuzz_target!(|data: &[u8]| {
                 "{r:?} in {w}x{h}"
             );
             assert!(d.score_permille >= det.min_score_permille, "{d:?}");
-            if d.score_permille < SCORE_FULL_PERMILLE {
-                // A threshold just above the confidence: no target.
+            if d.score_permille < SCORE_FULL_PERMILLE && det.prior.is_none() {
+                // A threshold just above the confidence: no target (without a prior:
+                // with one, a box gated in the tracking window sends the search to the
+                // whole frame, whose winner may pass).
                 let stricter = AutoV2 {
                     min_score_permille: d.score_permille + 1,
                     ..det

@@ -61,10 +61,10 @@ pub struct EvalArgs {
     /// Write scores.csv, summary.csv and summary.json here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Tracking prior for auto: off (search every frame whole); jitter (the truth
-    /// box moved by up to 4 px and each side by up to 10 %, as a tracker would hand
-    /// it over); sequence (frames in file-name order, each frame's prior is auto's
-    /// box on the previous one; one thread).
+    /// Tracking prior for auto and auto-v2: off (search every frame whole); jitter
+    /// (the truth box moved by up to 4 px and each side by up to 10 %, as a tracker
+    /// would hand it over); sequence (frames in file-name order, each frame's prior is
+    /// the tracker's own box on the previous one; one thread).
     #[arg(long, default_value = "off", value_parser = parse_track)]
     pub track: scoring::Track,
     /// Which truth box scores: half (x0,y0,x1,y1: pixels covered at least the

@@ -86,10 +86,25 @@ impl DetectorBank {
         }
     }
 
-    /// Sets `auto`'s tracking prior (the last frame's box; `None`: search the whole
-    /// frame).
+    /// Sets the tracking prior of both trackers, `auto` and `auto-v2` (the last
+    /// frame's box; `None`: search the whole frame).
     pub fn set_prior(&mut self, prior: Option<Roi>) {
-        self.auto.prior = prior;
+        self.set_prior_of(Method::Auto, prior);
+        self.set_prior_of(Method::AutoV2, prior);
+    }
+
+    /// Sets the tracking prior of `method` when it tracks (`auto`, `auto-v2`); the
+    /// other methods have none and are left as they are.
+    pub fn set_prior_of(&mut self, method: Method, prior: Option<Roi>) {
+        match method {
+            Method::Auto => self.auto.prior = prior,
+            Method::AutoV2 => {
+                if let Some(Params::AutoV2(v2)) = self.others.get_mut(Method::AutoV2.index()) {
+                    v2.prior = prior;
+                }
+            }
+            _ => {}
+        }
     }
 
     /// Sets `auto-v2`'s saturated cut (`AutoV2::saturated_erode_px`, px per side): a
@@ -285,8 +300,15 @@ mod tests {
         bank.set_prior(Some(prior));
         let want = Auto::default().with_prior(Some(prior));
         assert_eq!(bank.params(Method::Auto), Params::Auto(want));
+        assert_eq!(
+            bank.params(Method::AutoV2),
+            Params::AutoV2(AutoV2::default().with_prior(Some(prior)))
+        );
         // The other methods keep their defaults.
-        for method in Method::ALL.iter().filter(|m| **m != Method::Auto) {
+        for method in Method::ALL
+            .iter()
+            .filter(|m| !matches!(**m, Method::Auto | Method::AutoV2))
+        {
             assert_eq!(bank.params(*method), method.default_params(), "{method}");
         }
         // A budgeted call runs the bank's `auto` (prior included): same answer as the

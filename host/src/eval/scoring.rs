@@ -512,9 +512,10 @@ pub enum Track {
     /// and each side grown or shrunk by up to 10 % of the box size, from a hash of the
     /// file name ([`jittered_prior`]), so the same frame always gets the same prior.
     Jitter,
-    /// The frames, in file-name order, are one sequence: each frame's prior is `auto`'s
-    /// box on the previous frame (none on the first frame and after a miss). Frames
-    /// are scored one after the other on one thread.
+    /// The frames, in file-name order, are one sequence: each frame's prior is the
+    /// tracker's (`auto`'s, `auto-v2`'s) own box on the previous frame (none on the
+    /// first frame and after a miss). Frames are scored one after the other on one
+    /// thread.
     Sequence,
 }
 
@@ -645,8 +646,8 @@ fn score_one(
     Ok((score, d.roi))
 }
 
-/// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, `auto`'s
-/// prior from its box on the previous frame.
+/// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, each
+/// tracker's (`auto`, `auto-v2`) prior from its own box on the previous frame.
 fn score_sequence(
     images: &Path,
     rows: &[TruthRow],
@@ -660,7 +661,8 @@ fn score_sequence(
     }
     let mut order: Vec<&TruthRow> = rows.iter().collect();
     order.sort_by(|a, b| a.file.cmp(&b.file));
-    let mut previous = None;
+    // Each tracker's box on the previous frame, by method.
+    let mut previous: Vec<Option<Roi>> = vec![None; options.methods.len()];
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
@@ -668,12 +670,10 @@ fn score_sequence(
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
-        bank.set_prior(previous);
-        for &m in &options.methods {
+        for (&m, prev) in options.methods.iter().zip(previous.iter_mut()) {
+            bank.set_prior_of(m, *prev);
             let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
-            if m == Method::Auto {
-                previous = roi;
-            }
+            *prev = roi;
             scores.push(score);
         }
         progress();

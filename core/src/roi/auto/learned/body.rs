@@ -25,10 +25,11 @@
 //! the refinement), the medians are found by bisection over the value range (17
 //! counting passes over the ring, no sort, no copy).
 
-use super::cells::CELL_PX;
+use super::cells::{CELL_PX, cell_plane};
 use super::order::select;
 use crate::frame::Frame;
 use crate::roi::Roi;
+use crate::roi::plane::Window;
 
 /// Mark of a winner cell in the plane given to [`body_box`].
 pub const WINNER: u8 = 1;
@@ -239,19 +240,21 @@ fn departing(
 }
 
 /// The whole body's box (see the module): `marks` holds the winner's cells of the
-/// `plane` of 8×8 cells (`mean_dn`: their mean DN) marked [`WINNER`], others 0 (the
-/// grown cells are marked [`GROWN`] on return); `roi` is the box found so far, kept
-/// (and returned unchanged) when the stage is off, the ring is empty, nothing grows or
-/// the growth breaks a bound. The result holds `roi`.
-pub fn body_box(
+/// plane of 8×8 cells of the frame's window `win` ([`cell_plane`]; `mean_dn`: their
+/// mean DN) marked [`WINNER`], others 0 (the grown cells are marked [`GROWN`] on
+/// return); `roi` is the box found so far, kept (and returned unchanged) when the
+/// stage is off, the ring is empty, nothing grows or the growth breaks a bound. The
+/// result holds `roi`; what it adds lies inside the window.
+pub(crate) fn body_box(
     frame: &Frame<'_>,
+    win: Window,
     mean_dn: &[u16],
     marks: &mut [u8],
-    plane: (usize, usize),
     sigma_dn: u32,
     roi: Roi,
     p: BodyParams,
 ) -> Roi {
+    let plane = cell_plane(win);
     let (pw, ph) = plane;
     let n = pw * ph;
     if p.k_sigma == 0 || n == 0 || roi.x1 <= roi.x0 || roi.y1 <= roi.y0 {
@@ -281,12 +284,11 @@ pub fn body_box(
     if across {
         return roi;
     }
-    // The grown box one cell wider per side, in pixels (cut to the frame).
-    let (fw, fh) = (frame.width(), frame.height());
-    let mut x0 = gb.x0.saturating_sub(1) * CELL_PX;
-    let mut y0 = gb.y0.saturating_sub(1) * CELL_PX;
-    let mut x1 = ((gb.x1 + 2) * CELL_PX).min(fw);
-    let mut y1 = ((gb.y1 + 2) * CELL_PX).min(fh);
+    // The grown box one cell wider per side, in frame pixels (cut to the window).
+    let mut x0 = win.x0 + gb.x0.saturating_sub(1) * CELL_PX;
+    let mut y0 = win.y0 + gb.y0.saturating_sub(1) * CELL_PX;
+    let mut x1 = win.x0 + ((gb.x1 + 2) * CELL_PX).min(win.w);
+    let mut y1 = win.y0 + ((gb.y1 + 2) * CELL_PX).min(win.h);
     let need = |len: usize| (len as u32 * u32::from(p.trim_permille) / 1000).max(2);
     // Trim each side to its first line with enough departing pixels.
     while x0 + 1 < x1 && departing(frame, x0, (y0, y1), true, level, thr) < need(y1 - y0) {
@@ -480,9 +482,9 @@ mod tests {
             let hot = Roi::new(100, 60, 140, 90);
             let got = body_box(
                 &frame,
+                Window::full(&frame),
                 &mean,
                 &mut marks,
-                (pw, ph),
                 20,
                 hot,
                 BodyParams::DEFAULT,
@@ -494,9 +496,9 @@ mod tests {
             assert_eq!(
                 body_box(
                     &frame,
+                    Window::full(&frame),
                     &mean,
                     &mut marks2,
-                    (pw, ph),
                     20,
                     hot,
                     BodyParams::OFF
@@ -519,9 +521,9 @@ mod tests {
         let roi = Roi::new(160, 152, 168, 160);
         let got = body_box(
             &frame,
+            Window::full(&frame),
             &mean,
             &mut marks,
-            (pw, ph),
             20,
             roi,
             BodyParams::DEFAULT,
@@ -529,15 +531,23 @@ mod tests {
         assert_eq!(got, roi);
         // Bad input: empty planes and boxes are safe.
         assert_eq!(
-            body_box(&frame, &[], &mut [], (0, 0), 20, roi, BodyParams::DEFAULT),
+            body_box(
+                &frame,
+                Window::full(&frame),
+                &[],
+                &mut [],
+                20,
+                roi,
+                BodyParams::DEFAULT
+            ),
             roi
         );
         assert_eq!(
             body_box(
                 &frame,
+                Window::full(&frame),
                 &mean,
                 &mut marks,
-                (pw, ph),
                 20,
                 Roi::EMPTY,
                 BodyParams::DEFAULT

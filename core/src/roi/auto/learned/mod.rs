@@ -49,6 +49,14 @@ use features::{FEATURES, FrameLevels, Integrals, cell_features, integrate, level
 /// Parameters of `auto-v2`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AutoV2 {
+    /// Tracking prior: the last frame's box, or `None` to search the whole frame. With
+    /// a prior, every stage runs first on a window around it (the prior grown by
+    /// [`TRACK_MARGIN_PX`] + max(width, height) / [`TRACK_MARGIN_DIVISOR`] per side,
+    /// cut to the frame); that box stands when it passes the gate, overlaps the prior
+    /// and no side of it lies on a border of the window inside the frame, else the
+    /// whole frame is searched. Any box is accepted; it is cut to the frame, and an
+    /// empty result means no prior.
+    pub prior: Option<Roi>,
     /// Full-resolution boundary threshold, multiples of σ: 1..=1000. Default 8 (as `auto`).
     pub fine_sigma: u16,
     /// A cell is a target cell when its score reaches this, score units
@@ -85,6 +93,14 @@ pub struct AutoV2 {
     pub blob: BlobRule,
 }
 
+/// Tracking window margin around the prior, pixels: `auto`'s default (room for a move
+/// of several pixels per frame).
+pub const TRACK_MARGIN_PX: usize = 16;
+
+/// The tracking margin grows by max(width, height) / this of the prior: `auto`'s
+/// default (12.5 %: a 10 % change of size per frame fits).
+pub const TRACK_MARGIN_DIVISOR: usize = 8;
+
 /// The answer "no target": no box, confidence 0.
 const NO_TARGET: Detection = Detection {
     roi: None,
@@ -109,6 +125,7 @@ const BLOB_RELABEL_PX: u8 = 8;
 impl Default for AutoV2 {
     fn default() -> Self {
         AutoV2 {
+            prior: None,
             fine_sigma: 8,
             cell_score: 0,
             min_score_permille: 550,
@@ -346,7 +363,7 @@ fn cell_pass<C: FrameCapacity>(
 ) -> ((usize, usize), FrameLevels) {
     let win = Window::full(frame);
     let (plane, lv) = prepare(frame, work, win);
-    classify_cells(frame, work, plane, lv, screen, code);
+    classify_cells(frame, work, win, plane, lv, screen, code);
     (plane, lv)
 }
 
@@ -354,12 +371,12 @@ fn cell_pass<C: FrameCapacity>(
 fn classify_cells<C: FrameCapacity>(
     frame: &Frame<'_>,
     work: &mut AutoV2Work<C>,
+    win: Window,
     plane: (usize, usize),
     lv: FrameLevels,
     screen: bool,
     mut code: impl FnMut(usize, usize, &[i32; FEATURES]) -> u8,
 ) {
-    let win = Window::full(frame);
     let ints = Integrals {
         sum: work.sum.as_mut(),
         sum_sq: work.sum_sq.as_mut(),
@@ -464,8 +481,62 @@ fn logistic_permille(score: i32) -> u16 {
 }
 
 impl AutoV2 {
+    /// Sets the tracking prior ([`AutoV2::prior`]).
+    pub const fn with_prior(self, prior: Option<Roi>) -> Self {
+        AutoV2 { prior, ..self }
+    }
+
+    /// The tracking window around the prior, `None` without a prior, for an empty one
+    /// (cut to the frame) or when the window is the whole frame.
+    fn tracking_window(&self, frame: &Frame<'_>) -> Option<(Roi, Window)> {
+        let p = self
+            .prior?
+            .clip(frame.width() as u16, frame.height() as u16);
+        if p.is_empty() {
+            return None;
+        }
+        let m = TRACK_MARGIN_PX + usize::from(p.width().max(p.height())) / TRACK_MARGIN_DIVISOR;
+        let win = Window::clipped(
+            frame,
+            usize::from(p.x0).saturating_sub(m),
+            usize::from(p.y0).saturating_sub(m),
+            usize::from(p.x1) + m,
+            usize::from(p.y1) + m,
+        )?;
+        (!win.is_full(frame)).then_some((p, win))
+    }
+
+    /// The detection: in the tracking window first when there is a prior (its box
+    /// stands when it passes the gate, overlaps the prior and is not cut by the
+    /// window's border inside the frame), else on the whole frame.
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
-        let win = Window::full(frame);
+        if let Some((prior, win)) = self.tracking_window(frame) {
+            let d = self.run_in(frame, work, win);
+            let (fw, fh) = (frame.width(), frame.height());
+            let kept = d.roi.is_some_and(|r| {
+                let (x0, y0) = (usize::from(r.x0), usize::from(r.y0));
+                let (x1, y1) = (usize::from(r.x1), usize::from(r.y1));
+                !r.intersection(&prior).is_empty()
+                    && (x0 > win.x0 || win.x0 == 0)
+                    && (y0 > win.y0 || win.y0 == 0)
+                    && (x1 < win.x0 + win.w || x1 == fw)
+                    && (y1 < win.y0 + win.h || y1 == fh)
+            });
+            if kept {
+                return d;
+            }
+        }
+        self.run_in(frame, work, Window::full(frame))
+    }
+
+    /// Every stage on the frame's window `win` (the whole frame, or the tracking
+    /// window): cell planes, levels and the noise of the window alone.
+    fn run_in<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+    ) -> Detection {
         // Stages 1–2: noise, cell planes, levels, integrals.
         let (plane8, lv) = prepare(frame, work, win);
         work.winner = None;
@@ -476,29 +547,37 @@ impl AutoV2 {
         let blob_score = match self.blob {
             BlobRule::Off => None,
             BlobRule::Compete | BlobRule::Always => {
-                self.blob_stage(frame, work, plane8, lv, Counts::FromPrepare)
+                self.blob_stage(frame, work, win, plane8, lv, Counts::FromPrepare)
             }
         };
         if self.blob == BlobRule::Always {
             if let Some((winner, score_permille)) = blob_score {
-                return self.finish_blob(frame, work, plane8, lv, winner, score_permille);
+                return self.finish_blob(frame, work, win, plane8, lv, winner, score_permille);
             }
         }
         let blob_score = blob_score.map(|(_, score)| score);
         // Stage 3: classify the cells; codes 1..=255 for target cells (the score
         // above the cell threshold, in quarter units of log-odds), 0 otherwise.
         let cell_score = i32::from(self.cell_score);
-        classify_cells(frame, work, plane8, lv, self.prescreen, |_, _, feats| {
-            // The flat form of `forest_trees.rs` (built at compile time; the same
-            // score as walking its nodes, `forest::score`).
-            let s = forest::FLIGHT.score(feats);
-            let above = s - cell_score;
-            if above >= 0 {
-                (1 + above / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8
-            } else {
-                0
-            }
-        });
+        classify_cells(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            self.prescreen,
+            |_, _, feats| {
+                // The flat form of `forest_trees.rs` (built at compile time; the same
+                // score as walking its nodes, `forest::score`).
+                let s = forest::FLIGHT.score(feats);
+                let above = s - cell_score;
+                if above >= 0 {
+                    (1 + above / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8
+                } else {
+                    0
+                }
+            },
+        );
         let n8 = plane8.0 * plane8.1;
         // Stage 4: components of target cells; the strongest wins.
         let next = label_edge_cells(
@@ -512,7 +591,7 @@ impl AutoV2 {
         work.winner = None;
         let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
             return self
-                .blob_over(frame, work, plane8, lv, blob_score, 0)
+                .blob_over(frame, work, win, plane8, lv, blob_score, 0)
                 .unwrap_or(NO_TARGET);
         };
         let (mut components, mut runner_up) = (0u16, 0u32);
@@ -586,22 +665,32 @@ impl AutoV2 {
             shape,
         });
         let score_permille = work.winner.map_or(0, |w| w.score_permille());
-        if let Some(d) = self.blob_over(frame, work, plane8, lv, blob_score, score_permille) {
+        if let Some(d) = self.blob_over(frame, work, win, plane8, lv, blob_score, score_permille) {
             return d;
         }
         if score_permille < self.min_score_permille {
             return NO_TARGET;
         }
-        self.finish(frame, work, plane8, lv, (root, w8, next), score_permille)
+        self.finish(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            (root, w8, next),
+            score_permille,
+        )
     }
 
     /// [`BlobRule::Compete`]: the blob's detection when its confidence `blob_score`
     /// reaches the gate and is above the classifier winner's `classifier_score` (‰; 0
     /// without a winner); `None` leaves the classifier's answer standing.
+    #[allow(clippy::too_many_arguments)]
     fn blob_over<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoV2Work<C>,
+        win: Window,
         plane8: (usize, usize),
         lv: FrameLevels,
         blob_score: Option<u16>,
@@ -613,15 +702,17 @@ impl AutoV2 {
         }
         // The blob's labels again (stage 3 overwrote them): the same frame, the same
         // labels and confidence.
-        let (winner, score) = self.blob_stage(frame, work, plane8, lv, Counts::Recount)?;
-        Some(self.finish_blob(frame, work, plane8, lv, winner, score))
+        let (winner, score) = self.blob_stage(frame, work, win, plane8, lv, Counts::Recount)?;
+        Some(self.finish_blob(frame, work, win, plane8, lv, winner, score))
     }
 
     /// Stages 5–8 on the blob's winner; below the gate, no target.
+    #[allow(clippy::too_many_arguments)]
     fn finish_blob<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoV2Work<C>,
+        win: Window,
         plane8: (usize, usize),
         lv: FrameLevels,
         winner: (u8, CellStats, usize),
@@ -631,7 +722,7 @@ impl AutoV2 {
         if score_permille < self.min_score_permille {
             return NO_TARGET;
         }
-        self.finish(frame, work, plane8, lv, winner, score_permille)
+        self.finish(frame, work, win, plane8, lv, winner, score_permille)
     }
 
     /// Stage 2b ([`blob`]): the frame's largest saturated blob, its statistics in
@@ -643,11 +734,11 @@ impl AutoV2 {
         &self,
         frame: &Frame<'_>,
         work: &mut AutoV2Work<C>,
+        win: Window,
         plane8: (usize, usize),
         lv: FrameLevels,
         counts: Counts,
     ) -> Option<((u8, CellStats, usize), u16)> {
-        let win = Window::full(frame);
         let n8 = plane8.0 * plane8.1;
         let plane = work.labels4.as_mut().get_mut(..n8)?;
         let total = match counts {
@@ -694,16 +785,17 @@ impl AutoV2 {
     /// Stages 5–8 on the winner (`root`, its cell statistics, one past the last
     /// label) of `labels8`: `auto`'s refinement in its gate, the whole body, the half
     /// maximum, the saturated cut.
+    #[allow(clippy::too_many_arguments)]
     fn finish<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
         work: &mut AutoV2Work<C>,
+        win: Window,
         plane8: (usize, usize),
         lv: FrameLevels,
         (root, w8, next): (u8, CellStats, usize),
         score_permille: u16,
     ) -> Detection {
-        let win = Window::full(frame);
         let n8 = plane8.0 * plane8.1;
         // Stage 5: the 4×4 gate plane from the 8×8 labels, then `auto`'s refinement.
         let plane4 = (win.w.div_ceil(4), win.h.div_ceil(4));
@@ -782,13 +874,15 @@ impl AutoV2 {
         let (roi, edge_px) = outline(frame, &gate, &region, noise, tau, saturated, &counts);
         // Without a boundary inside the gate, the winner's cells are the box.
         let roi = roi.or_else(|| {
-            let (fw, fh) = (frame.width(), frame.height());
-            let px = |c: usize, lim: usize| (c * 8).min(lim) as u16;
+            // Cells of the window to frame pixels, cut to the window.
+            let px = |c: usize, origin: usize, len: usize| {
+                (origin + (c * cells::CELL_PX).min(len)) as u16
+            };
             Some(Roi {
-                x0: px(usize::from(w8.x0), fw),
-                y0: px(usize::from(w8.y0), fh),
-                x1: px(usize::from(w8.x_last) + 1, fw),
-                y1: px(usize::from(w8.y_last) + 1, fh),
+                x0: px(usize::from(w8.x0), win.x0, win.w),
+                y0: px(usize::from(w8.y0), win.y0, win.h),
+                x1: px(usize::from(w8.x_last) + 1, win.x0, win.w),
+                y1: px(usize::from(w8.y_last) + 1, win.y0, win.h),
             })
         });
         // Stage 6: the whole body, grown from the winner's cells over cells hotter or
@@ -812,7 +906,7 @@ impl AutoV2 {
                     0
                 };
             }
-            body::body_box(frame, mean_dn, marks, plane8, lv.sigma, r, self.body)
+            body::body_box(frame, win, mean_dn, marks, lv.sigma, r, self.body)
         });
         // Stage 7: small boxes cut to their half maximum (far targets' blur).
         let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
@@ -1175,6 +1269,80 @@ mod tests {
         }
         // Both outcomes occur (the block's outline seeds, the flat texture does not).
         assert!(seeds > 0 && seeds < 3 * 41 * 31, "{seeds}");
+    }
+
+    /// A noisy flat frame (σ ≈ 8 DN) with uniform blocks `(x0, y0, x1, y1, DN above)`.
+    fn blocks_frame(blocks: &[(usize, usize, usize, usize, u16)]) -> std::vec::Vec<u16> {
+        let mut s = 0x2545_f491u32;
+        (0..FRAME_WIDTH * FRAME_HEIGHT)
+            .map(|i| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                let (x, y) = (i % FRAME_WIDTH, i / FRAME_WIDTH);
+                // Sum of 4 uniform draws of 0..16: mean 30, σ ≈ 9.2 DN.
+                let noise = (s & 15) + ((s >> 8) & 15) + ((s >> 16) & 15) + ((s >> 24) & 15);
+                let lift = blocks
+                    .iter()
+                    .filter(|b| (b.0..b.2).contains(&x) && (b.1..b.3).contains(&y))
+                    .map(|b| b.4)
+                    .max()
+                    .unwrap_or(0);
+                (2000 + noise as u16 + lift).min(16383)
+            })
+            .collect()
+    }
+
+    /// Tracking: with a prior on the weaker of two targets, the box is that target's
+    /// (the window around the prior is searched first); a prior far from any target,
+    /// an empty one, one outside the frame and one of the whole frame give the answer
+    /// without a prior (the whole frame is searched).
+    #[test]
+    fn tracking_keeps_the_prior_target_and_falls_back_to_the_frame() {
+        let strong = (60usize, 60usize, 120usize, 110usize, 3000u16);
+        let weak = (230usize, 150usize, 270usize, 190usize, 1500u16);
+        let px = blocks_frame(&[strong, weak]);
+        let frame = Frame::reference(&px).unwrap();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let det = AutoV2::default();
+        let free = det.detect(&frame, &mut scratch).unwrap();
+        let near = |r: Roi, b: (usize, usize, usize, usize, u16)| {
+            r.iou(&Roi::new(b.0 as u16, b.1 as u16, b.2 as u16, b.3 as u16)) > 0.8
+        };
+        let r = free.roi.expect("the strong block is found without a prior");
+        assert!(near(r, strong), "{r:?}");
+        // The weak block, tracked from a prior 3 px off and a little small.
+        let prior = Roi::new(233, 152, 266, 185);
+        let tracked = det
+            .with_prior(Some(prior))
+            .detect(&frame, &mut scratch)
+            .unwrap();
+        let r = tracked.roi.expect("the tracked block is found");
+        assert!(near(r, weak), "{r:?}");
+        assert!(tracked.score_permille >= det.min_score_permille);
+        // Same answer twice.
+        assert_eq!(
+            tracked,
+            det.with_prior(Some(prior))
+                .detect(&frame, &mut scratch)
+                .unwrap()
+        );
+        // Priors without a target inside, empty, off the frame or the whole frame: the
+        // whole frame is searched.
+        for p in [
+            Roi::new(0, 200, 20, 240),
+            Roi::EMPTY,
+            Roi::new(400, 300, 420, 320),
+            Roi::new(0, 0, FRAME_WIDTH as u16, FRAME_HEIGHT as u16),
+        ] {
+            assert_eq!(
+                det.with_prior(Some(p))
+                    .detect(&frame, &mut scratch)
+                    .unwrap(),
+                free,
+                "{p:?}"
+            );
+        }
     }
 
     #[test]
