@@ -352,3 +352,100 @@ fn detect_budget_stops_auto_and_says_where() {
     let got: Option<[u16; 4]> = serde_json::from_value(v["bbox"].clone()).unwrap();
     assert_eq!(got, want);
 }
+
+/// `detect --prior` hands the trackers (`auto`, `auto-v2`) the box of the frame
+/// before, and `--track` chains each tracker's own box from file to file: the boxes
+/// are the library's with those priors; the other methods ignore them; a reversed
+/// prior is one error line and exit code 2.
+#[test]
+fn detect_prior_and_track_are_the_library_trackers() {
+    use tirroi::core::Detector;
+    use tirroi::core::roi::auto::Auto;
+    use tirroi::core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+    let dir = fixtures();
+    let file = dir.path().join("earth.png");
+    let f = file.to_str().unwrap();
+    let prior = Roi::new(118, 78, 228, 152);
+    let buf = read_frame(&file, None).expect("readable frame");
+    let frame = buf.view().expect("valid frame");
+    let v2 = AutoV2 {
+        saturated_erode_px: 0,
+        ..AutoV2::default()
+    };
+    let with = |p: Option<Roi>| {
+        v2.with_prior(p)
+            .detect(&frame, &mut Box::new(AutoV2Scratch::new()))
+            .expect("valid parameters")
+            .roi
+            .map(|r| r.to_array())
+    };
+    let mut bank = Box::new(Detectors::new());
+    let v1 = |p: Option<Roi>, bank: &mut Detectors| {
+        bank.detect(
+            &tirroi::core::roi::Params::Auto(Auto::default().with_prior(p)),
+            &frame,
+        )
+        .expect("valid parameters")
+        .roi
+        .map(|r| r.to_array())
+    };
+    let out = run(&[
+        "detect",
+        "--method",
+        "auto-v2",
+        "--json",
+        "--saturated-erode-px",
+        "0",
+        "--prior",
+        "118,78,228,152",
+        "--track",
+        f,
+        f,
+    ]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    let first = parse_line(&lines[0]).2;
+    assert!(first.is_some(), "the target is found: {lines:?}");
+    assert_eq!(first, with(Some(prior)));
+    let first_roi = first.map(|[x0, y0, x1, y1]| Roi::new(x0, y0, x1, y1));
+    assert_eq!(parse_line(&lines[1]).2, with(first_roi));
+    // `auto` the same way; a method that does not track gives its own box.
+    let out = run(&[
+        "detect",
+        "--method",
+        "auto",
+        "--json",
+        "--prior",
+        "118,78,228,152",
+        f,
+    ]);
+    assert!(out.status.success(), "{}", stderr_text(&out));
+    assert_eq!(
+        parse_line(&stdout_lines(&out)[0]).2,
+        v1(Some(prior), &mut bank)
+    );
+    let out = run(&[
+        "detect",
+        "--method",
+        "otsu",
+        "--json",
+        "--prior",
+        "118,78,228,152",
+        f,
+    ]);
+    assert_eq!(
+        parse_line(&stdout_lines(&out)[0]).2,
+        library_detection(Method::Otsu, &file)
+            .roi
+            .map(|r| r.to_array())
+    );
+    // A reversed box: an error naming the option, exit code 2.
+    let out = run(&["detect", "--prior", "5,5,3,3", f]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr_text(&out).contains("--prior"),
+        "{}",
+        stderr_text(&out)
+    );
+}

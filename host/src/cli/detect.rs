@@ -58,6 +58,17 @@ pub struct DetectArgs {
     #[arg(long, value_name = "PX", default_value_t = AutoV2::default().saturated_erode_px,
           value_parser = clap::value_parser!(u8).range(0..=8))]
     pub saturated_erode_px: u8,
+    /// The trackers (`auto`, `auto-v2`) only: the target's box on the frame before the
+    /// first file, x0,y0,x1,y1 (px, x1 and y1 exclusive); each searches a window around
+    /// it first (the box found there stands when it passes, else the whole frame is
+    /// searched). The other methods ignore it.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_prior)]
+    pub prior: Option<tirroi_core::Roi>,
+    /// The files are a sequence, in the order given: each tracker's prior on a file is
+    /// its own box on the file before (none after a miss; on the first file,
+    /// `--prior`).
+    #[arg(long)]
+    pub track: bool,
     /// Frames to process (PNG, TIFF or FITS).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -102,6 +113,21 @@ impl BudgetLine {
     }
 }
 
+/// Parses `--prior`: four integers x0,y0,x1,y1 (px) with x0 < x1 and y0 < y1.
+fn parse_prior(s: &str) -> Result<tirroi_core::Roi, String> {
+    let v: Vec<u16> = s
+        .split(',')
+        .map(|p| p.trim().parse::<u16>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("`{s}`: expected x0,y0,x1,y1 (px, integers 0..=65535)"))?;
+    match v[..] {
+        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok(tirroi_core::Roi::new(x0, y0, x1, y1)),
+        _ => Err(format!(
+            "`{s}`: expected four integers x0,y0,x1,y1 with x0 < x1, y0 < y1"
+        )),
+    }
+}
+
 /// Runs `tirroi detect`: every method on every frame, one line (or JSON object) each.
 pub fn run(args: &DetectArgs) -> ExitCode {
     let (methods, repeat, json, bits, files) = (
@@ -119,6 +145,8 @@ pub fn run(args: &DetectArgs) -> ExitCode {
     let mut failed = false;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
+    // Each method's prior for the next file (used by the trackers only).
+    let mut priors = vec![args.prior; methods.len()];
     for path in files {
         let options = ReadOptions {
             bits,
@@ -146,7 +174,8 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                 continue;
             }
         };
-        for &method in methods {
+        for (&method, prior) in methods.iter().zip(priors.iter_mut()) {
+            bank.set_prior_of(method, *prior);
             let budget = args
                 .budget
                 .filter(|_| method == Method::Auto)
@@ -166,6 +195,9 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     return ExitCode::from(EXIT_BAD_INPUT);
                 }
             };
+            if args.track {
+                *prior = d.roi;
+            }
             let file = path.to_string_lossy();
             let written = if json {
                 let line = DetectLine {
