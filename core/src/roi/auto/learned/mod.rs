@@ -52,9 +52,9 @@ pub struct AutoV2 {
     /// Tracking prior: the last frame's box, or `None` to search the whole frame. With
     /// a prior, every stage runs first on a window around it (the prior grown by
     /// [`TRACK_MARGIN_PX`] + max(width, height) / [`TRACK_MARGIN_DIVISOR`] per side,
-    /// cut to the frame); that box stands when it passes the gate, overlaps the prior
-    /// and no side of it lies on a border of the window inside the frame, else the
-    /// whole frame is searched. Any box is accepted; it is cut to the frame, and an
+    /// cut to the frame; none over [`TRACK_MAX_WINDOW_PERMILLE`] of the frame); that
+    /// box stands when it passes the gate, overlaps the prior and no side of it lies on
+    /// a border of the window inside the frame, else the whole frame is searched. Any box is accepted; it is cut to the frame, and an
     /// empty result means no prior.
     pub prior: Option<Roi>,
     /// Full-resolution boundary threshold, multiples of σ: 1..=1000. Default 8 (as `auto`).
@@ -100,6 +100,13 @@ pub const TRACK_MARGIN_PX: usize = 16;
 /// The tracking margin grows by max(width, height) / this of the prior: `auto`'s
 /// default (12.5 %: a 10 % change of size per frame fits).
 pub const TRACK_MARGIN_DIVISOR: usize = 8;
+
+/// A tracking window over more than this share of the frame's pixels, ‰, is not
+/// searched: the whole frame is at once. Such a window saves less than half of a
+/// whole-frame search, and when the target is lost in it the call pays both: with the
+/// cap a call with a prior costs at most 1½ whole-frame searches (the worst case of
+/// `auto-v2+prior`, docs/flight.md).
+pub const TRACK_MAX_WINDOW_PERMILLE: usize = 500;
 
 /// The answer "no target": no box, confidence 0.
 const NO_TARGET: Detection = Detection {
@@ -487,7 +494,8 @@ impl AutoV2 {
     }
 
     /// The tracking window around the prior, `None` without a prior, for an empty one
-    /// (cut to the frame) or when the window is the whole frame.
+    /// (cut to the frame) or when the window is over [`TRACK_MAX_WINDOW_PERMILLE`] of
+    /// the frame.
     fn tracking_window(&self, frame: &Frame<'_>) -> Option<(Roi, Window)> {
         let p = self
             .prior?
@@ -503,7 +511,8 @@ impl AutoV2 {
             usize::from(p.x1) + m,
             usize::from(p.y1) + m,
         )?;
-        (!win.is_full(frame)).then_some((p, win))
+        let frame_px = frame.width() * frame.height();
+        (win.w * win.h * 1000 <= frame_px * TRACK_MAX_WINDOW_PERMILLE).then_some((p, win))
     }
 
     /// The detection: in the tracking window first when there is a prior (its box
@@ -1327,13 +1336,15 @@ mod tests {
                 .detect(&frame, &mut scratch)
                 .unwrap()
         );
-        // Priors without a target inside, empty, off the frame or the whole frame: the
-        // whole frame is searched.
+        // Priors without a target inside, empty, off the frame, the whole frame or with
+        // a window over half the frame (here 177 × 248 px, 54 %): the whole frame is
+        // searched.
         for p in [
             Roi::new(0, 200, 20, 240),
             Roi::EMPTY,
             Roi::new(400, 300, 420, 320),
             Roi::new(0, 0, FRAME_WIDTH as u16, FRAME_HEIGHT as u16),
+            Roi::new(0, 0, 130, 248),
         ] {
             assert_eq!(
                 det.with_prior(Some(p))
