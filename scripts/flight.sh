@@ -161,7 +161,7 @@ if [[ $callgrind -eq 1 ]]; then
     frames=$(awk '$1 == "link" { sub("frame=", "", $2); print $2 }' "$out/host-demo.log")
     methods=$(awk '$1 == "memory" { sub("method=", "", $2); print $2 }' "$out/host-demo.log")
     for frame in $frames on-board-sensor; do
-        for method in $methods auto+prior; do
+        for method in $methods auto+prior auto-v2+prior; do
             cg="$out/callgrind.$frame.$method.out"
             toggle='*Detectors*run*'
             [[ $method == *+prior ]] && toggle='*Detectors*track*'

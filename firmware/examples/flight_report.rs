@@ -184,10 +184,12 @@ fn run(dir: &Path, target_names: &[String]) -> Result<Vec<String>, String> {
         .filter(|l| l.kind == "memory")
         .map(|l| field(l, "method").to_string())
         .collect();
-    // The columns of the instruction tables: every method, then `auto` tracking.
+    // The columns of the instruction tables: every method, then the trackers tracking.
     let mut columns = methods.clone();
-    if host.iter().any(|l| field(l, "method") == "auto+prior") {
-        columns.push("auto+prior".to_string());
+    for tracking in ["auto+prior", "auto-v2+prior"] {
+        if host.iter().any(|l| field(l, "method") == tracking) {
+            columns.push(tracking.to_string());
+        }
     }
 
     // The host CLI's boxes for the embedded frames.

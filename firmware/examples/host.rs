@@ -6,11 +6,13 @@
 //! cargo run --release --example host                       # the whole demo, one line per event
 //! cargo run --release --example host -- FRAME METHOD       # one detector on one frame, once
 //! cargo run --release --example host -- FRAME auto+prior   # auto, then auto tracking its box
+//! cargo run --release --example host -- FRAME auto-v2+prior   # the same for auto-v2
 //! cargo run --release --example host -- on-board-sensor -  # only the sensor model
 //! ```
 //!
 //! The second form is what scripts/flight.sh runs under `valgrind --tool=callgrind
-//! --toggle-collect=...Detectors::run...` (`...Detectors::track...` for `auto+prior`)
+//! --toggle-collect=...Detectors::run...` (`...Detectors::track...` for `auto+prior`
+//! and `auto-v2+prior`)
 //! to count one call.
 
 use std::process::ExitCode;
@@ -95,9 +97,13 @@ fn one(ws: &mut Workspace<'_>, frame: &str, method: &str) -> Result<String, Stri
         Frame::new(&pixels[..], FRAME_WIDTH, FRAME_HEIGHT, BITS).map_err(|e| e.to_string())?;
     let mut detection = detectors.run(method, &view).map_err(|e| e.to_string())?;
     if tracking {
-        // As the firmware: `auto` again with its own box as the prior.
-        let prior = detection.roi.ok_or("auto found nothing to track")?;
-        detection = detectors.track(prior, &view).map_err(|e| e.to_string())?;
+        // As the firmware: the tracker again with its own box as the prior.
+        let prior = detection
+            .roi
+            .ok_or_else(|| format!("{method} found nothing to track"))?;
+        detection = detectors
+            .track(method, prior, &view)
+            .map_err(|e| e.to_string())?;
     }
     Ok(format!("{frame} {method} {:?}", detection.roi))
 }

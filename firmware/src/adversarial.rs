@@ -181,6 +181,14 @@ pub const PRIORS: [Roi; 8] = [
     ),
 ];
 
+/// Priors whose tracking windows are the largest `auto-v2` still searches before the
+/// whole frame (`TRACK_MAX_WINDOW_PERMILLE`: half the frame; the window is the prior
+/// grown by 16 px + its longer side on every side): a 92 px box in a corner (window
+/// 200 × 200 px, 49 % of the frame) and a 56 px box in the middle (200 × 200 px). With
+/// [`PRIORS`], what `auto-v2` tracks with on every case: a target lost in such a
+/// window costs the window and the whole frame, its worst case.
+pub const LARGE_WINDOW_PRIORS: [Roi; 2] = [Roi::new(0, 0, 92, 92), Roi::new(136, 96, 192, 152)];
+
 /// xorshift64* (Vigna 2016): a fixed, tiny generator, so every target makes the same
 /// frames.
 struct XorShift(u64);

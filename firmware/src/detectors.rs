@@ -76,6 +76,12 @@ const NOT_SWITCHED: DetectError = DetectError::InvalidParameter {
     expected: "the shared area switched to the detector",
 };
 
+/// The error of [`Detectors::track`] for a method that does not track.
+const NOT_A_TRACKER: DetectError = DetectError::InvalidParameter {
+    name: "method",
+    expected: "a tracker: auto or auto-v2",
+};
+
 /// Runs detector `$params` in the `$Variant` of a [`SharedScratch`].
 macro_rules! run_in {
     ($shared:expr, $Variant:ident, $params:expr, $frame:expr) => {{
@@ -84,6 +90,24 @@ macro_rules! run_in {
             None => Err(NOT_SWITCHED),
         }
     }};
+}
+
+/// Runs `auto-v2` with `params` in the shared area, switched to a fresh `auto-v2`
+/// scratch first when another detector used it last.
+fn auto_v2_in(
+    shared: &mut SharedScratch,
+    params: AutoV2,
+    frame: &Frame<'_>,
+) -> Result<Detection, DetectError> {
+    if !matches!(shared, SharedScratch::AutoV2(_)) {
+        // From a constant (copied from flash), not built on the stack and moved as
+        // `scratch_in!` does: LLVM turns the other detectors' fresh scratch into a
+        // memset of the area, but built that way `auto-v2`'s put a 33 KB temporary in
+        // this function's frame, on every detector's call (stack peak 9.3 -> 43 KB).
+        // The constant is the whole area, 74 KB of flash, for 33 KB of RAM (peak 9.5 KB).
+        *shared = FRESH_AUTO_V2;
+    }
+    run_in!(shared, AutoV2, params, frame)
 }
 
 /// The detectors with their default parameters (what `tirroi detect` runs on the host,
@@ -123,32 +147,37 @@ impl Detectors {
             Method::Wge => run_in!(shared, Wge, Wge::default(), frame),
             Method::Dog => run_in!(shared, Dog, Dog::default(), frame),
             Method::Auto => run_in!(shared, Auto, Auto::default(), frame),
-            Method::AutoV2 => {
-                if !matches!(shared, SharedScratch::AutoV2(_)) {
-                    // From a constant (copied from flash), not built on the stack and
-                    // moved as `scratch_in!` does: LLVM turns the other detectors'
-                    // fresh scratch into a memset of the area, but built that way
-                    // `auto-v2`'s put a 33 KB temporary in this function's frame, on
-                    // every detector's call (stack peak 9.3 -> 43 KB). The constant is
-                    // the whole area, 74 KB of flash, for 33 KB of RAM (peak 9.5 KB).
-                    *shared = FRESH_AUTO_V2;
-                }
-                run_in!(shared, AutoV2, AutoV2::default(), frame)
-            }
+            Method::AutoV2 => auto_v2_in(shared, AutoV2::default(), frame),
         }
     }
 
-    /// Runs `auto` in tracking mode: only a window around `prior` (the last frame's
-    /// box) is processed, the whole frame only when the target is lost there.
+    /// Runs a tracker, `auto` or `auto-v2` (default parameters), in tracking mode: a
+    /// window around `prior` (the last frame's box) first, the whole frame only when
+    /// the target is lost there.
     ///
     /// Never inlined, for the same reason as [`Detectors::run`].
     ///
     /// # Errors
-    /// [`DetectError`] when the default parameters are refused (never).
+    /// [`DetectError::InvalidParameter`] for a method that does not track (`method`).
     #[inline(never)]
-    pub fn track(&mut self, prior: Roi, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        let params = Auto::default().with_prior(Some(prior));
-        run_in!(&mut self.shared, Auto, params, frame)
+    pub fn track(
+        &mut self,
+        method: Method,
+        prior: Roi,
+        frame: &Frame<'_>,
+    ) -> Result<Detection, DetectError> {
+        match method {
+            Method::Auto => {
+                let params = Auto::default().with_prior(Some(prior));
+                run_in!(&mut self.shared, Auto, params, frame)
+            }
+            Method::AutoV2 => auto_v2_in(
+                &mut self.shared,
+                AutoV2::default().with_prior(Some(prior)),
+                frame,
+            ),
+            _ => Err(NOT_A_TRACKER),
+        }
     }
 
     /// Runs `auto` (tracking `prior` if given) within a work budget in Cortex-M7

@@ -7,8 +7,8 @@
 //! 1. every embedded frame ([`frames::FRAMES`], rendered by the host) is streamed in
 //!    through the SPI frame link of the core ([`tirroi_core::link`]) from a simulated
 //!    camera into the one frame buffer, with one corrupted row to show a retry;
-//! 2. every detector of the core runs on it ([`detectors::Detectors`]), then `auto` in
-//!    tracking mode with its own box as the prior;
+//! 2. every detector of the core runs on it ([`detectors::Detectors`]), then the
+//!    trackers (`auto`, `auto-v2`) in tracking mode, each with its own box as the prior;
 //! 3. the camera model makes a frame on board ([`synth`]: band radiance table, DN map,
 //!    noise, row by row into the same buffer), and the detectors run on that too.
 //!
@@ -187,30 +187,24 @@ fn detect_all<M: Meter>(
             return;
         }
     };
-    let mut prior = None;
+    // Each tracker's box, the prior of its tracking call below.
+    let mut priors = [(Method::Auto, None), (Method::AutoV2, None)];
     for &method in DEMO_METHODS {
         meter.start();
         let result = black_box(detectors.run(method, &frame));
         let reading = meter.stop();
         let found = report_detection(emit, name, method, None, truth, result, reading);
-        if method == Method::Auto {
-            prior = found;
+        if let Some((_, prior)) = priors.iter_mut().find(|(m, _)| *m == method) {
+            *prior = found;
         }
     }
-    // Tracking: `auto` again, given its own box as the last frame's.
-    if let Some(prior) = prior {
+    // Tracking: each tracker again, given its own box as the last frame's.
+    for (method, prior) in priors {
+        let Some(prior) = prior else { continue };
         meter.start();
-        let result = black_box(detectors.track(prior, &frame));
+        let result = black_box(detectors.track(method, prior, &frame));
         let reading = meter.stop();
-        report_detection(
-            emit,
-            name,
-            Method::Auto,
-            Some(prior),
-            truth,
-            result,
-            reading,
-        );
+        report_detection(emit, name, method, Some(prior), truth, result, reading);
     }
 }
 

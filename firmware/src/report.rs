@@ -48,7 +48,8 @@ pub enum Event {
         frame: &'static str,
         /// The detector.
         method: Method,
-        /// The tracking prior it was given (`auto` only), `None` for a full-frame search.
+        /// The tracking prior it was given (the trackers, `auto` and `auto-v2`, only),
+        /// `None` for a full-frame search.
         prior: Option<Roi>,
         /// Its box, `None` when nothing was foreground.
         roi: Option<Roi>,

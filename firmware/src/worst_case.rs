@@ -1,7 +1,8 @@
 //! Worst-case instruction counts on the emulated Cortex-M7 (issue 18, part 2; run by
 //! scripts/worst-case.sh): every detector of the core on every adversarial frame of
-//! [`tirroi_firmware::adversarial`], and `auto` tracking each of its priors, one line
-//! per call over semihosting:
+//! [`tirroi_firmware::adversarial`], `auto` tracking each of its priors and `auto-v2`
+//! each of them and the largest windows it searches, one line per call over
+//! semihosting:
 //!
 //! ```text
 //! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248 passes=1
@@ -27,7 +28,7 @@ mod target {
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
     use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
     use tirroi_core::{DetectError, Detection, Frame, Method};
-    use tirroi_firmware::adversarial::{self, PRIORS};
+    use tirroi_firmware::adversarial::{self, LARGE_WINDOW_PRIORS, PRIORS};
     use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
 
@@ -129,11 +130,28 @@ mod target {
             }
             if DEMO_METHODS.contains(&Method::Auto) {
                 for prior in PRIORS {
-                    let (result, n) = count(overhead, || DETECTORS.track(prior, &frame));
+                    let (result, n) =
+                        count(overhead, || DETECTORS.track(Method::Auto, prior, &frame));
                     failed |= result.is_err();
                     calls += 1;
                     hprintln!(
                         "worst case={case} method=auto+prior prior={},{},{},{} instructions={n} box={}",
+                        prior.x0,
+                        prior.y0,
+                        prior.x1,
+                        prior.y1,
+                        BoxOf(&result)
+                    );
+                }
+            }
+            if DEMO_METHODS.contains(&Method::AutoV2) {
+                for prior in PRIORS.iter().chain(&LARGE_WINDOW_PRIORS).copied() {
+                    let (result, n) =
+                        count(overhead, || DETECTORS.track(Method::AutoV2, prior, &frame));
+                    failed |= result.is_err();
+                    calls += 1;
+                    hprintln!(
+                        "worst case={case} method=auto-v2+prior prior={},{},{},{} instructions={n} box={}",
                         prior.x0,
                         prior.y0,
                         prior.x1,

@@ -7,6 +7,10 @@
 //! 0–255, i.e. the share of the cell covered by the target × 255; for a dataset without
 //! `masks/`, e.g. `tirroi fixtures --count N --seed S`, the truth box stands for the mask).
 //!
+//! `... -- track-self DIR OUT.csv` is `predict` with each box then tracked: `auto-v2`
+//! again with its own box as the prior (what tracking alone changes on a target that
+//! does not move).
+//!
 //! `... -- predict DIR OUT.csv` runs `auto-v2` on every frame and writes
 //! `file,x0,y0,x1,y1,score` (then the winner's statistics) for `tirroi eval
 //! --predictions`; `predict-all` the same with the confidence gate off (every winner
@@ -141,7 +145,15 @@ fn main() {
                     blob,
                     ..AutoV2::default()
                 };
-                let d = gate_off.detect(&frame, &mut scratch).expect("detect");
+                let mut d = gate_off.detect(&frame, &mut scratch).expect("detect");
+                // `track-self`: the tracker given its own box as the last frame's (a
+                // target that does not move: what tracking alone changes).
+                if mode == "track-self" && d.roi.is_some() {
+                    d = gate_off
+                        .with_prior(d.roi)
+                        .detect(&frame, &mut scratch)
+                        .expect("detect");
+                }
                 match d.roi {
                     Some(r) => {
                         let _ = write!(
