@@ -16,14 +16,15 @@
 #
 # Usage: scripts/panic-never.sh [--all-pending-fail] [COMPONENT...]
 #   with COMPONENTs: check only these, all required (e.g. `scripts/panic-never.sh auto`).
-#   components: otsu adaptive wge dog auto auto-prior sensor auto-v2 (cargo features of the check)
+#   components: otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior (cargo
+#   features of the check)
 # Needs: apt-get install rustc-web cargo-web rust-web-src lld binutils-arm-none-eabi
 #        (arm-none-eabi-objdump/addr2line, from gcc-arm-none-eabi) python3.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 
-REQUIRED=(otsu adaptive wge dog auto auto-prior sensor auto-v2)
+REQUIRED=(otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior)
 PENDING=()
 
 if [[ $# -gt 0 ]]; then

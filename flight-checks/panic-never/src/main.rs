@@ -3,7 +3,7 @@
 //! A link-time proof that the flight calls cannot panic (issue 18, part 1): this
 //! bare-metal binary calls what the firmware calls — each detector through the
 //! firmware's registry calls ([`Detectors::run`] for the paper's four and `auto`,
-//! [`Detectors::track`] for `auto` with a prior) and the on-board camera model
+//! [`Detectors::track`] for `auto` and `auto-v2` with a prior) and the on-board camera model
 //! ([`synth::setup`], [`synth::expose_scene`]) — on inputs the optimiser cannot see
 //! ([`black_box`]), and its panic handler calls a function that exists nowhere. The
 //! release build (fat LTO, `panic = "abort"`, as the firmware's) drops every panic
@@ -11,8 +11,8 @@
 //! referenced and the link fails with `undefined symbol: tirroi_panic_path_found`.
 //!
 //! Which components are linked is chosen by cargo features (`otsu`, `adaptive`, `wge`,
-//! `dog`, `auto`, `auto-prior`, `sensor`, and `auto-v2`, the development detector, called
-//! from the core directly); `scripts/panic-never.sh` builds the required
+//! `dog`, `auto`, `auto-prior`, `sensor`, `auto-v2`, the development detector, called
+//! from the core directly, and `auto-v2-prior`, it tracking through the firmware); `scripts/panic-never.sh` builds the required
 //! set, and on a failure or for components not yet required, each one alone, and names
 //! the functions and source lines that still reach a panic.
 //!
@@ -88,7 +88,22 @@ pub extern "C" fn _start() -> ! {
                 black_box(0),
                 black_box(0),
             ));
-            let _ = black_box(detectors.track(prior, &frame));
+            let _ = black_box(detectors.track(Method::Auto, prior, &frame));
+        }
+    }
+    #[cfg(feature = "auto-v2-prior")]
+    {
+        let width = black_box(FRAME_WIDTH);
+        let height = black_box(FRAME_HEIGHT);
+        if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, DEFAULT_BIT_DEPTH) {
+            // Any prior box, also one outside the frame.
+            let prior = black_box(Roi::new(
+                black_box(0),
+                black_box(0),
+                black_box(0),
+                black_box(0),
+            ));
+            let _ = black_box(detectors.track(Method::AutoV2, prior, &frame));
         }
     }
     #[cfg(feature = "auto-v2")]

@@ -193,7 +193,7 @@ fn grow(
             if marks.get(i) != Some(&0) || !body(i) {
                 continue;
             }
-            let (x, y) = (i % pw, i / pw);
+            let (x, y) = (i % pw.max(1), i / pw.max(1));
             let touches = (y.saturating_sub(1)..(y + 2).min(ph)).any(|ny| {
                 (x.saturating_sub(1)..(x + 2).min(pw))
                     .any(|nx| marks.get(ny * pw + nx).is_some_and(|&m| m != 0))

@@ -40,8 +40,11 @@ pub fn fill_cells(
 ) {
     let max_dn = frame.max_dn();
     let (pw, ph) = cell_plane(win);
-    let sums = &mut sums[..pw];
-    let steps = &mut steps[..pw];
+    // The caller's rows hold a plane row of any window of the frame (`get_mut`: no
+    // panic path, nothing filled if they were short).
+    let (Some(sums), Some(steps)) = (sums.get_mut(..pw), steps.get_mut(..pw)) else {
+        return;
+    };
     let (x0, w) = (win.x0, win.w);
     let fw = frame.width();
     let fh = frame.height();
@@ -70,7 +73,9 @@ pub fn fill_cells(
                 .enumerate()
             {
                 let xa = x0 + cx * CELL_PX;
-                let xb = (xa + CELL_PX).min(x0 + w);
+                // Inside the frame (a window always is; `min(fw)` says so to the
+                // compiler: no bounds check per read below).
+                let xb = (xa + CELL_PX).min(x0 + w).min(fw);
                 // An inner cell (a pixel on each side, both neighbouring rows): the same
                 // sums and steps from slices, without a bounds check per read.
                 if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {

@@ -426,7 +426,12 @@ fn prepare<C: FrameCapacity>(
     win: Window,
 ) -> ((usize, usize), FrameLevels) {
     let plane = cell_plane(win);
-    let n = plane.0 * plane.1;
+    // Every window of a frame that fits the capacity has at most the planes' cells;
+    // `min` says so to the compiler (no panic path in the slicing below).
+    let n = (plane.0 * plane.1)
+        .min(work.mean_dn.as_ref().len())
+        .min(work.step_code.as_ref().len())
+        .min(work.labels4.as_ref().len());
     let sigma = noise_sigma_second(frame, win, &mut work.hist, work.pixel_row.as_mut());
     fill_cells(
         frame,
@@ -589,7 +594,12 @@ impl AutoV2 {
                 }
             },
         );
-        let n8 = plane8.0 * plane8.1;
+        // The planes hold every window's cells (`min`: no panic path in the slicing).
+        let n8 = (plane8.0 * plane8.1)
+            .min(work.labels4.as_ref().len())
+            .min(work.labels8.as_ref().len())
+            .min(work.mean_dn.as_ref().len())
+            .min(work.step_code.as_ref().len());
         // Stage 4: components of target cells; the strongest wins.
         let next = label_edge_cells(
             &work.labels4.as_ref()[..n8],

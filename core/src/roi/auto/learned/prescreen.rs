@@ -143,7 +143,7 @@ pub fn cascade(
     let mut top = 0usize;
     let mut classified = 0usize;
     for i in 0..n {
-        if seed(i % pw, i / pw) {
+        if seed(i % pw.max(1), i / pw.max(1)) {
             classified += visit(i, pw, codes, marks, stack, &mut top, &mut classify);
         }
     }
@@ -153,7 +153,7 @@ pub fn cascade(
             .get(2 * top..2 * top + 2)
             .and_then(|p| <[u8; 2]>::try_from(p).ok())
             .map_or(0, |p| usize::from(u16::from_le_bytes(p)));
-        let (cx, cy) = (i % pw, i / pw);
+        let (cx, cy) = (i % pw.max(1), i / pw.max(1));
         for ny in cy.saturating_sub(1)..=(cy + 1).min(ph.saturating_sub(1)) {
             for nx in cx.saturating_sub(1)..=(cx + 1).min(pw.saturating_sub(1)) {
                 classified += visit(
