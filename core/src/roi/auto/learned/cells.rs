@@ -73,9 +73,7 @@ pub fn fill_cells(
                 .enumerate()
             {
                 let xa = x0 + cx * CELL_PX;
-                // Inside the frame (a window always is; `min(fw)` says so to the
-                // compiler: no bounds check per read below).
-                let xb = (xa + CELL_PX).min(x0 + w).min(fw);
+                let xb = (xa + CELL_PX).min(x0 + w);
                 // An inner cell (a pixel on each side, both neighbouring rows): the same
                 // sums and steps from slices, without a bounds check per read.
                 if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
@@ -88,7 +86,9 @@ pub fn fill_cells(
                 let mut acc = 0u32;
                 let mut best = *st;
                 let mut n_sat = 0u8;
-                for x in xa..xb {
+                // Inside the frame (a window always is; `min(fw)` says so to the
+                // compiler: no bounds check per read below).
+                for x in xa..xb.min(fw) {
                     n_sat += u8::from(row[x] >= max_dn);
                     let v = row[x].min(max_dn);
                     acc += u32::from(v);
