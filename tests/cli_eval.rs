@@ -753,3 +753,119 @@ fn multi_page_tiff_and_bits_below_the_data() {
         &["eight.png", "needs 8 bits"],
     );
 }
+
+/// `eval --track jitter` and `--track sequence` give both trackers (`auto`, `auto-v2`)
+/// their prior: each box in `scores.csv` is the library tracker's with the prior the
+/// mode defines (jitter: `jittered_prior` of the truth; sequence: the tracker's own
+/// box on the file before, by file name), and a frame without a target has none; on a
+/// frame with two targets the jittered prior on the weaker one makes both box it.
+#[test]
+fn eval_track_hands_both_trackers_their_priors() {
+    use tirroi::core::Detector;
+    use tirroi::core::Roi;
+    use tirroi::core::roi::auto::Auto;
+    use tirroi::core::roi::auto::AutoScratch;
+    use tirroi::core::roi::auto::learned::{AutoV2, AutoV2Scratch};
+    use tirroi::host::eval::scoring::jittered_prior;
+    use tirroi::host::imaging::image_io::read_frame;
+    let (dir, mut truth) = fixtures_with_an_empty_frame();
+    // A frame with two targets, the truth the weaker one: only a tracker handed a prior
+    // near it boxes it (noise σ ≈ 9 DN on 2 000 DN; blocks 3 000 and 1 500 DN above).
+    let weak = [230u16, 150, 270, 190];
+    let mut state = 0x2545_f491u32;
+    let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(328, 248, |x, y| {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise =
+            (state & 15) + ((state >> 8) & 15) + ((state >> 16) & 15) + ((state >> 24) & 15);
+        let inside = |b: [u32; 4]| (b[0]..b[2]).contains(&x) && (b[1]..b[3]).contains(&y);
+        let lift = if inside([60, 60, 120, 110]) {
+            3000
+        } else if inside(weak.map(u32::from)) {
+            1500
+        } else {
+            0
+        };
+        image::Luma([(2000 + noise + lift) as u16])
+    });
+    img.save(dir.path().join("two-targets.png")).unwrap();
+    let mut text = fs::read_to_string(dir.path().join("truth.csv")).unwrap();
+    text.push_str(&format!(
+        "two-targets.png,{},{},{},{}\n",
+        weak[0], weak[1], weak[2], weak[3]
+    ));
+    fs::write(dir.path().join("truth.csv"), text).unwrap();
+    truth.push(("two-targets.png".to_string(), Some(weak)));
+    let boxed = |r: Option<Roi>| r.map(|r| r.to_array());
+    // The library's answer of `method` with `prior` on `file` (no manifest: auto-v2's
+    // saturated cut is 0, as `eval` takes it).
+    let library = |method: &str, file: &str, prior: Option<Roi>| {
+        let buf = read_frame(&dir.path().join(file), None).unwrap();
+        let frame = buf.view().unwrap();
+        match method {
+            "auto" => {
+                Auto::default()
+                    .with_prior(prior)
+                    .detect(&frame, &mut Box::new(AutoScratch::new()))
+                    .unwrap()
+                    .roi
+            }
+            _ => {
+                AutoV2 {
+                    saturated_erode_px: 0,
+                    ..AutoV2::default()
+                }
+                .with_prior(prior)
+                .detect(&frame, &mut Box::new(AutoV2Scratch::new()))
+                .unwrap()
+                .roi
+            }
+        }
+    };
+    // `x0..y1` of a scores.csv row: four empty fields for no box.
+    let parse = |f: &[String]| -> Bbox {
+        (!f[0].is_empty()).then(|| [0, 1, 2, 3].map(|k| f[k].parse().unwrap()))
+    };
+    for mode in ["jitter", "sequence"] {
+        let out = dir.path().join(format!("eval-{mode}"));
+        ok(&run(&[
+            "eval",
+            "--images",
+            s(dir.path()),
+            "--method",
+            "all",
+            "--track",
+            mode,
+            "--out",
+            s(&out),
+        ]));
+        let (h, rows) = csv(&out.join("scores.csv"));
+        let (fc, mc) = (col(&h, "file"), col(&h, "method"));
+        let (x0, y1) = (col(&h, "x0"), col(&h, "y1"));
+        let mut previous: BTreeMap<String, Option<Roi>> = BTreeMap::new();
+        let mut files: Vec<&(String, Bbox)> = truth.iter().collect();
+        files.sort_by(|a, b| a.0.cmp(&b.0));
+        for (file, t) in files {
+            for method in ["auto", "auto-v2"] {
+                let row = rows
+                    .iter()
+                    .find(|r| r[fc] == *file && r[mc] == method)
+                    .unwrap_or_else(|| panic!("{file} {method} in scores.csv"));
+                let got = parse(&row[x0..=y1]);
+                let prior = match mode {
+                    "jitter" => t.map(|b| jittered_prior(Roi::new(b[0], b[1], b[2], b[3]), file)),
+                    _ => previous.get(method).copied().flatten(),
+                };
+                let want = library(method, file, prior);
+                assert_eq!(got, boxed(want), "{mode} {file} {method} prior {prior:?}");
+                if mode == "jitter" && file == "two-targets.png" {
+                    // The prior is what makes the answer: the weaker target's box, not
+                    // the stronger one's found without a prior.
+                    assert_ne!(want, library(method, file, None), "{method}");
+                }
+                previous.insert(method.to_string(), want);
+            }
+        }
+    }
+}
