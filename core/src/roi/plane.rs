@@ -4,6 +4,7 @@
 //! pixels.
 
 use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH, Frame};
+use crate::roi::Roi;
 
 /// Block side of the downsampled planes, in pixels.
 pub const BLOCK: usize = 4;
@@ -65,6 +66,42 @@ impl Window {
     pub fn is_full(&self, frame: &Frame<'_>) -> bool {
         self.x0 == 0 && self.y0 == 0 && self.w == frame.width() && self.h == frame.height()
     }
+
+    /// A tracker's window: `prior` cut to the frame (`None` when nothing is left),
+    /// grown by `margin(prior)` px on every side and cut to the frame again. Returns the
+    /// cut prior and the window.
+    pub fn around(
+        frame: &Frame<'_>,
+        prior: Roi,
+        margin: impl FnOnce(Roi) -> usize,
+    ) -> Option<(Roi, Window)> {
+        let p = prior.clip(frame.width() as u16, frame.height() as u16);
+        if p.is_empty() {
+            return None;
+        }
+        let m = margin(p);
+        let win = Window::clipped(
+            frame,
+            usize::from(p.x0).saturating_sub(m),
+            usize::from(p.y0).saturating_sub(m),
+            usize::from(p.x1) + m,
+            usize::from(p.y1) + m,
+        )?;
+        Some((p, win))
+    }
+
+    /// Whether `r`, found in this tracking window, is still the tracked target: it
+    /// overlaps `prior` and is not cut by the window (a side on the window's border is
+    /// one on the frame's border, else the target left the window).
+    pub fn keeps(&self, frame: &Frame<'_>, prior: &Roi, r: &Roi) -> bool {
+        let (x0, y0) = (usize::from(r.x0), usize::from(r.y0));
+        let (x1, y1) = (usize::from(r.x1), usize::from(r.y1));
+        !r.intersection(prior).is_empty()
+            && (x0 > self.x0 || self.x0 == 0)
+            && (y0 > self.y0 || self.y0 == 0)
+            && (x1 < self.x0 + self.w || x1 == frame.width())
+            && (y1 < self.y0 + self.h || y1 == frame.height())
+    }
 }
 
 /// Rounded means of the `BLOCK × BLOCK` blocks of `win` (partial blocks at the right
@@ -109,4 +146,57 @@ pub(crate) fn block_means(
         }
     }
     (pw, ph)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The window around a prior against the rectangle worked out by hand, at the
+    /// frame's edges too; `keeps` against each of its conditions.
+    #[test]
+    fn tracking_window_and_kept_box_by_hand() {
+        let px = [0u16; FRAME_WIDTH * FRAME_HEIGHT];
+        let frame = Frame::reference(&px).unwrap();
+        // 20 px margin around (100, 80)-(140, 100): (80, 60)-(160, 120).
+        let (p, w) = Window::around(&frame, Roi::new(100, 80, 140, 100), |_| 20).unwrap();
+        assert_eq!(p, Roi::new(100, 80, 140, 100));
+        assert_eq!((w.x0, w.y0, w.w, w.h), (80, 60, 80, 60));
+        // The margin gets the prior cut to the frame; the window is cut too.
+        let (p, w) = Window::around(&frame, Roi::new(320, 240, 400, 300), |p| {
+            usize::from(p.width())
+        })
+        .unwrap();
+        assert_eq!(p, Roi::new(320, 240, 328, 248));
+        assert_eq!((w.x0, w.y0, w.w, w.h), (312, 232, 16, 16));
+        // Nothing of the prior inside the frame: no window.
+        assert!(Window::around(&frame, Roi::new(400, 300, 420, 320), |_| 20).is_none());
+        assert!(Window::around(&frame, Roi::EMPTY, |_| 20).is_none());
+        // Kept: overlaps the prior, no side on the window's border inside the frame.
+        let (p, w) = Window::around(&frame, Roi::new(100, 80, 140, 100), |_| 20).unwrap();
+        assert!(w.keeps(&frame, &p, &Roi::new(95, 75, 145, 105)));
+        assert!(
+            !w.keeps(&frame, &p, &Roi::new(150, 110, 155, 115)),
+            "misses the prior"
+        );
+        assert!(
+            !w.keeps(&frame, &p, &Roi::new(80, 75, 145, 105)),
+            "on the left border"
+        );
+        assert!(
+            !w.keeps(&frame, &p, &Roi::new(95, 75, 160, 105)),
+            "on the right border"
+        );
+        assert!(
+            !w.keeps(&frame, &p, &Roi::new(95, 60, 145, 105)),
+            "on the top border"
+        );
+        assert!(
+            !w.keeps(&frame, &p, &Roi::new(95, 75, 145, 120)),
+            "on the bottom border"
+        );
+        // A window on the frame's edge: a side there is the frame's, kept.
+        let (p, w) = Window::around(&frame, Roi::new(0, 0, 20, 20), |_| 10).unwrap();
+        assert!(w.keeps(&frame, &p, &Roi::new(0, 0, 25, 25)));
+    }
 }

@@ -504,20 +504,9 @@ impl AutoV2 {
     /// (cut to the frame) or when the window is over [`TRACK_MAX_WINDOW_PERMILLE`] of
     /// the frame.
     fn tracking_window(&self, frame: &Frame<'_>) -> Option<(Roi, Window)> {
-        let p = self
-            .prior?
-            .clip(frame.width() as u16, frame.height() as u16);
-        if p.is_empty() {
-            return None;
-        }
-        let m = TRACK_MARGIN_PX + usize::from(p.width().max(p.height()));
-        let win = Window::clipped(
-            frame,
-            usize::from(p.x0).saturating_sub(m),
-            usize::from(p.y0).saturating_sub(m),
-            usize::from(p.x1) + m,
-            usize::from(p.y1) + m,
-        )?;
+        let (p, win) = Window::around(frame, self.prior?, |p| {
+            TRACK_MARGIN_PX + usize::from(p.width().max(p.height()))
+        })?;
         let frame_px = frame.width() * frame.height();
         (win.w * win.h * 1000 <= frame_px * TRACK_MAX_WINDOW_PERMILLE).then_some((p, win))
     }
@@ -528,17 +517,7 @@ impl AutoV2 {
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
         if let Some((prior, win)) = self.tracking_window(frame) {
             let d = self.run_in(frame, work, win);
-            let (fw, fh) = (frame.width(), frame.height());
-            let kept = d.roi.is_some_and(|r| {
-                let (x0, y0) = (usize::from(r.x0), usize::from(r.y0));
-                let (x1, y1) = (usize::from(r.x1), usize::from(r.y1));
-                !r.intersection(&prior).is_empty()
-                    && (x0 > win.x0 || win.x0 == 0)
-                    && (y0 > win.y0 || win.y0 == 0)
-                    && (x1 < win.x0 + win.w || x1 == fw)
-                    && (y1 < win.y0 + win.h || y1 == fh)
-            });
-            if kept {
+            if d.roi.is_some_and(|r| win.keeps(frame, &prior, &r)) {
                 return d;
             }
         }
