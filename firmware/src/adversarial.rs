@@ -184,10 +184,25 @@ pub const PRIORS: [Roi; 8] = [
 /// Priors whose tracking windows are the largest `auto-v2` still searches before the
 /// whole frame (`TRACK_MAX_WINDOW_PERMILLE`: half the frame; the window is the prior
 /// grown by 16 px + its longer side on every side): a 92 px box in a corner (window
-/// 200 × 200 px, 49 % of the frame) and a 56 px box in the middle (200 × 200 px). With
-/// [`PRIORS`], what `auto-v2` tracks with on every case: a target lost in such a
-/// window costs the window and the whole frame, its worst case.
+/// 200 × 200 px, 49 % of the frame) and a 56 px box in the middle (200 × 200 px): a
+/// target lost in such a window costs the window and the whole frame, its worst case.
 pub const LARGE_WINDOW_PRIORS: [Roi; 2] = [Roi::new(0, 0, 92, 92), Roi::new(136, 96, 192, 152)];
+
+/// What `auto-v2` tracks with on every case: [`PRIORS`], then
+/// [`LARGE_WINDOW_PRIORS`].
+pub const AUTO_V2_PRIORS: [Roi; PRIORS.len() + LARGE_WINDOW_PRIORS.len()] = {
+    let mut all = [Roi::EMPTY; PRIORS.len() + LARGE_WINDOW_PRIORS.len()];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = if i < PRIORS.len() {
+            PRIORS[i]
+        } else {
+            LARGE_WINDOW_PRIORS[i - PRIORS.len()]
+        };
+        i += 1;
+    }
+    all
+};
 
 /// xorshift64* (Vigna 2016): a fixed, tiny generator, so every target makes the same
 /// frames.

@@ -27,8 +27,8 @@ mod target {
     use panic_semihosting as _;
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
     use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
-    use tirroi_core::{DetectError, Detection, Frame, Method};
-    use tirroi_firmware::adversarial::{self, LARGE_WINDOW_PRIORS, PRIORS};
+    use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
+    use tirroi_firmware::adversarial::{self, AUTO_V2_PRIORS, PRIORS};
     use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
 
@@ -128,30 +128,20 @@ mod target {
                     ),
                 }
             }
-            if DEMO_METHODS.contains(&Method::Auto) {
-                for prior in PRIORS {
-                    let (result, n) =
-                        count(overhead, || DETECTORS.track(Method::Auto, prior, &frame));
-                    failed |= result.is_err();
-                    calls += 1;
-                    hprintln!(
-                        "worst case={case} method=auto+prior prior={},{},{},{} instructions={n} box={}",
-                        prior.x0,
-                        prior.y0,
-                        prior.x1,
-                        prior.y1,
-                        BoxOf(&result)
-                    );
+            // The trackers with each of their priors: `auto` the border ones,
+            // `auto-v2` those and the largest windows it still searches.
+            let trackers: [(Method, &[Roi]); 2] =
+                [(Method::Auto, &PRIORS), (Method::AutoV2, &AUTO_V2_PRIORS)];
+            for (method, priors) in trackers {
+                if !DEMO_METHODS.contains(&method) {
+                    continue;
                 }
-            }
-            if DEMO_METHODS.contains(&Method::AutoV2) {
-                for prior in PRIORS.iter().chain(&LARGE_WINDOW_PRIORS).copied() {
-                    let (result, n) =
-                        count(overhead, || DETECTORS.track(Method::AutoV2, prior, &frame));
+                for &prior in priors {
+                    let (result, n) = count(overhead, || DETECTORS.track(method, prior, &frame));
                     failed |= result.is_err();
                     calls += 1;
                     hprintln!(
-                        "worst case={case} method=auto-v2+prior prior={},{},{},{} instructions={n} box={}",
+                        "worst case={case} method={method}+prior prior={},{},{},{} instructions={n} box={}",
                         prior.x0,
                         prior.y0,
                         prior.x1,

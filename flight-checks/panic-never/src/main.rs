@@ -56,6 +56,24 @@ fn detect(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
     }
 }
 
+/// Runs a tracker (`auto`, `auto-v2`) through the firmware's tracking call on an
+/// opaque frame with an opaque prior (any box, also one outside the frame).
+#[allow(dead_code)]
+#[inline(never)]
+fn track(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
+    let width = black_box(FRAME_WIDTH);
+    let height = black_box(FRAME_HEIGHT);
+    if let Ok(frame) = Frame::new(black_box(pixels), width, height, DEFAULT_BIT_DEPTH) {
+        let prior = black_box(Roi::new(
+            black_box(0),
+            black_box(0),
+            black_box(0),
+            black_box(0),
+        ));
+        let _ = black_box(detectors.track(method, prior, &frame));
+    }
+}
+
 /// The entry point the linker keeps (`ld.lld`'s default entry symbol): every checked
 /// call is reachable from here. `no_mangle` is the only way to name it for the linker.
 #[unsafe(no_mangle)]
@@ -77,35 +95,9 @@ pub extern "C" fn _start() -> ! {
     #[cfg(feature = "auto")]
     detect(detectors, Method::Auto, pixels);
     #[cfg(feature = "auto-prior")]
-    {
-        let width = black_box(FRAME_WIDTH);
-        let height = black_box(FRAME_HEIGHT);
-        if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, DEFAULT_BIT_DEPTH) {
-            // Any prior box, also one outside the frame.
-            let prior = black_box(Roi::new(
-                black_box(0),
-                black_box(0),
-                black_box(0),
-                black_box(0),
-            ));
-            let _ = black_box(detectors.track(Method::Auto, prior, &frame));
-        }
-    }
+    track(detectors, Method::Auto, pixels);
     #[cfg(feature = "auto-v2-prior")]
-    {
-        let width = black_box(FRAME_WIDTH);
-        let height = black_box(FRAME_HEIGHT);
-        if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, DEFAULT_BIT_DEPTH) {
-            // Any prior box, also one outside the frame.
-            let prior = black_box(Roi::new(
-                black_box(0),
-                black_box(0),
-                black_box(0),
-                black_box(0),
-            ));
-            let _ = black_box(detectors.track(Method::AutoV2, prior, &frame));
-        }
-    }
+    track(detectors, Method::AutoV2, pixels);
     #[cfg(feature = "auto-v2")]
     {
         // The development detector `auto-v2` (issue 16) is not in the firmware's
