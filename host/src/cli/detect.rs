@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::EXIT_BAD_INPUT;
 use super::methods::{MethodChoice, method_help, parse_methods};
 use crate::eval::bank::DetectorBank;
-use crate::imaging::image_io::{ReadOptions, parse_crop, read_frame_with};
+use crate::imaging::image_io::{ReadOptions, parse_box_px, parse_crop, read_frame_with};
 use tirroi_core::Method;
 use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
@@ -113,19 +113,10 @@ impl BudgetLine {
     }
 }
 
-/// Parses `--prior`: four integers x0,y0,x1,y1 (px) with x0 < x1 and y0 < y1.
+/// Parses `--prior`: four integers x0,y0,x1,y1 (px, 0..=65535) with x0 < x1 and
+/// y0 < y1.
 fn parse_prior(s: &str) -> Result<tirroi_core::Roi, String> {
-    let v: Vec<u16> = s
-        .split(',')
-        .map(|p| p.trim().parse::<u16>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("`{s}`: expected x0,y0,x1,y1 (px, integers 0..=65535)"))?;
-    match v[..] {
-        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok(tirroi_core::Roi::new(x0, y0, x1, y1)),
-        _ => Err(format!(
-            "`{s}`: expected four integers x0,y0,x1,y1 with x0 < x1, y0 < y1"
-        )),
-    }
+    parse_box_px::<u16>(s).map(|[x0, y0, x1, y1]| tirroi_core::Roi::new(x0, y0, x1, y1))
 }
 
 /// Runs `tirroi detect`: every method on every frame, one line (or JSON object) each.

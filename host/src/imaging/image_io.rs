@@ -97,15 +97,21 @@ pub fn parse_crop(s: &str) -> Result<[usize; 4], String> {
     if s == "hayabusa2-tir" {
         return Ok(HAYABUSA2_TIR_CROP);
     }
-    let v: Vec<usize> = s
+    parse_box_px::<usize>(s).map_err(|e| format!("{e} (or hayabusa2-tir)"))
+}
+
+/// Parses a box `x0,y0,x1,y1` (px, x1 and y1 exclusive) of integers of type `T` with
+/// x0 < x1 and y0 < y1 (`--crop`, `detect --prior`); the error says what was expected.
+pub fn parse_box_px<T: std::str::FromStr + PartialOrd + Copy>(s: &str) -> Result<[T; 4], String> {
+    let v: Vec<T> = s
         .split(',')
-        .map(|p| p.trim().parse::<usize>())
+        .map(|p| p.trim().parse::<T>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("`{s}`: expected x0,y0,x1,y1 (px) or hayabusa2-tir"))?;
+        .map_err(|_| format!("`{s}`: expected four integers x0,y0,x1,y1 (px)"))?;
     match v[..] {
         [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok([x0, y0, x1, y1]),
         _ => Err(format!(
-            "`{s}`: expected four integers x0,y0,x1,y1 with x0 < x1, y0 < y1 (or hayabusa2-tir)"
+            "`{s}`: expected four integers x0,y0,x1,y1 with x0 < x1, y0 < y1"
         )),
     }
 }
