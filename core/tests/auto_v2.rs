@@ -49,6 +49,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
             Just(BlobRule::Always)
         ],
         prior(),
+        any::<bool>(),
     )
         .prop_map(
             |(
@@ -60,6 +61,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 prescreen,
                 blob,
                 prior,
+                deep_space,
             )| {
                 AutoV2 {
                     prior,
@@ -70,6 +72,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     body,
                     prescreen,
                     blob,
+                    deep_space,
                 }
             },
         )

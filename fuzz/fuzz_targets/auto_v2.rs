@@ -44,6 +44,7 @@ fuzz_target!(|data: &[u8]| {
             BodyParams::OFF
         },
         prescreen: data[8] & 0x40 == 0,
+        deep_space: data[8] & 0x20 == 0,
         blob: match data[3] / 64 {
             0 => BlobRule::Off,
             1 => BlobRule::Always,

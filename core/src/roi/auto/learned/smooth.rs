@@ -1,0 +1,431 @@
+//! Stage 2c: deep space recognised by its statistics, not by DN 0. Behind a target in
+//! deep space a real camera shows only its own signal: a pedestal and a shading that
+//! is smooth across the frame (the Hayabusa2 TIR's dark frame: a dark centre, brighter
+//! edges, 30–100 DN), noise, fixed pattern and a few hot pixels. The Earth's clouds,
+//! limb and decks are not smooth at the 8-px scale. So the cell means are fitted by a
+//! smooth surface (a polynomial of degree [`DEGREE`] in the frame's coordinates, by
+//! least squares on 16×16-pixel blocks, trimmed of outliers over [`FIT_ROUNDS`]
+//! rounds); when the cells' residuals around it are within noise
+//! ([`MAX_SPREAD_PERMILLE`] of the pixel σ: the window is deep space), the cells that
+//! depart from it ([`OUTLIER_K`] × that spread, at least one σ) are the target's, and
+//! the classifier (trained on our renders, which miss most low-contrast targets over a
+//! shaded sky) is not asked.
+//!
+//! The constants were chosen on family A (realistic seed 7001: of its 36 radiometry
+//! frames at close range over deep space, the classifier's mean IoU is 0.19); a
+//! prototype (`docs/detectors.md` § Session 29) put the Earth frames' spread at
+//! 0.8–5.4 σ (5th–95th percentile) and deep space's at 0.2–0.44 σ.
+//!
+//! Memory: none of its own beyond the stack (a 15×15 `f32` system, 900 B); the cell
+//! planes are `auto-v2`'s. Cost: [`FIT_ROUNDS`] passes over ≤ 330 blocks (15 basis
+//! terms, 120 products each) and two over the cells.
+
+use super::order::select;
+
+/// Degree of the background surface: 4 fits the real dark frame's shading, whose
+/// corners rise faster than a paraboloid (family A: degree 2 leaves the corners as
+/// false components, 4 does not; 15 terms).
+pub const DEGREE: usize = 4;
+
+/// Terms of the polynomial of degree [`DEGREE`] in two variables.
+const TERMS: usize = (DEGREE + 1) * (DEGREE + 2) / 2;
+
+/// Cells per side of a fit block: the fit works on 2×2-cell (16×16-pixel) blocks,
+/// a quarter of the cells' products, as smooth as the shading it models.
+pub const BLOCK_CELLS: usize = 2;
+
+/// Least-squares rounds; after each, blocks beyond [`TRIM_K`] robust σ of the
+/// residuals leave the fit (a target covering up to a third of the frame is trimmed
+/// away in 2–3 rounds).
+pub const FIT_ROUNDS: usize = 4;
+
+/// Trimming threshold, robust σ of the block residuals (3: a Gaussian keeps 99.7 %).
+const TRIM_K: f32 = 3.0;
+
+/// The cells' robust residual spread must be at most this share of the pixel noise
+/// σ, ‰, for the window to be deep space: family A's deep-space frames 200–440 ‰,
+/// its Earth frames 810 ‰ and more (5th percentile).
+pub const MAX_SPREAD_PERMILLE: u32 = 600;
+
+/// A cell departs from the surface (a target cell) beyond this many spreads (and at
+/// least one pixel σ).
+pub const OUTLIER_K: f32 = 6.0;
+
+/// More than this share of departing cells, ‰, and the surface is no background model
+/// (a target over a third of the frame leaves too few cells to fit).
+pub const MAX_OUTLIER_PERMILLE: usize = 350;
+
+/// At least this share of the cells must be usable (not clipped at 0 nor at the top
+/// DN), ‰: a frame read out with its centre clipped has no shading to fit.
+pub const MIN_VALID_PERMILLE: usize = 500;
+
+/// The MAD of a Gaussian times this is its σ.
+const MAD_TO_SIGMA: f32 = 1.4826;
+
+/// Residuals in 1/16 DN for their median (an integer order statistic).
+const RESIDUAL_SCALE: f32 = 16.0;
+
+/// Legendre polynomials `P0..=P4` at `t` (−1..=1): an orthogonal basis keeps the
+/// normal equations well conditioned in `f32`.
+fn legendre(t: f32) -> [f32; DEGREE + 1] {
+    let t2 = t * t;
+    [
+        1.0,
+        t,
+        1.5 * t2 - 0.5,
+        (2.5 * t2 - 1.5) * t,
+        (4.375 * t2 - 3.75) * t2 + 0.375,
+    ]
+}
+
+/// The basis at cell coordinates `(x, y)` of a `pw × ph` plane (cell units, centres at
+/// `c + 0.5`).
+fn basis(x: f32, y: f32, (pw, ph): (usize, usize)) -> [f32; TERMS] {
+    let pu = legendre(2.0 * x / pw as f32 - 1.0);
+    let pv = legendre(2.0 * y / ph as f32 - 1.0);
+    let mut out = [0.0f32; TERMS];
+    let mut k = 0;
+    for (i, a) in pu.iter().enumerate() {
+        for b in pv.iter().take(DEGREE + 1 - i) {
+            if let Some(o) = out.get_mut(k) {
+                *o = a * b;
+            }
+            k += 1;
+        }
+    }
+    out
+}
+
+/// Solves `m · x = rhs` (symmetric positive definite) by Cholesky in place; `None` for
+/// a singular system. Index loops: the textbook triangular recurrences read rows and
+/// columns of the same matrix.
+#[allow(clippy::needless_range_loop)]
+fn solve(m: &mut [[f32; TERMS]; TERMS], rhs: &[f32; TERMS]) -> Option<[f32; TERMS]> {
+    for j in 0..TERMS {
+        let mut d = m[j][j];
+        for k in 0..j {
+            d -= m[j][k] * m[j][k];
+        }
+        if d.is_nan() || d <= 1e-6 * (1.0 + m[j][j].abs()) {
+            return None;
+        }
+        let d = libm::sqrtf(d);
+        m[j][j] = d;
+        for i in j + 1..TERMS {
+            let mut s = m[i][j];
+            for k in 0..j {
+                s -= m[i][k] * m[j][k];
+            }
+            m[i][j] = s / d;
+        }
+    }
+    let mut y = [0.0f32; TERMS];
+    for i in 0..TERMS {
+        let mut s = rhs[i];
+        for k in 0..i {
+            s -= m[i][k] * y[k];
+        }
+        y[i] = s / m[i][i];
+    }
+    let mut x = [0.0f32; TERMS];
+    for i in (0..TERMS).rev() {
+        let mut s = y[i];
+        for k in i + 1..TERMS {
+            s -= m[k][i] * x[k];
+        }
+        x[i] = s / m[i][i];
+    }
+    Some(x)
+}
+
+/// The robust spread (MAD × 1.4826) of `residuals()` (DN), from their median in
+/// 1/16 DN.
+fn robust_spread<I: Iterator<Item = f32>>(residuals: impl Fn() -> I) -> f32 {
+    let n = residuals().count();
+    if n == 0 {
+        return f32::INFINITY;
+    }
+    let code = |r: f32| (libm::fabsf(r) * RESIDUAL_SCALE).min(u32::MAX as f32 / 2.0) as u32;
+    let hi = residuals().map(code).max().unwrap_or(0);
+    let mad = select(|| residuals().map(code), n / 2, hi);
+    MAD_TO_SIGMA * (mad as f32 + 0.5) / RESIDUAL_SCALE
+}
+
+/// Whether a cell can be fitted: not clipped at the top DN (no saturated pixel) nor at
+/// 0 (a mean of 0 is a cell clipped whole).
+fn usable(mean: u16, saturated: u8) -> bool {
+    saturated == 0 && mean > 0
+}
+
+/// What stage 2c saw: the surface's spread and its departing cells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeepSpace {
+    /// Robust spread of the usable cells' residuals, DN.
+    pub spread_dn: f32,
+    /// Cells departing from the surface (target cells).
+    pub outliers: usize,
+}
+
+/// Stage 2c on the cell plane `(pw, ph)` (`mean_dn` and, in `saturated_then_codes`,
+/// the saturated counts as the cell pass left them; pixel noise `sigma_dn`): when the
+/// window is deep space, overwrites the counts with the target cells' codes (1..=255:
+/// the departure in thresholds, 0 elsewhere) and returns what it saw; `None` (the
+/// counts untouched) when it is not deep space or the fit fails. Slices shorter than
+/// the plane: `None`.
+pub fn deep_space_codes(
+    mean_dn: &[u16],
+    saturated_then_codes: &mut [u8],
+    (pw, ph): (usize, usize),
+    sigma_dn: u32,
+) -> Option<DeepSpace> {
+    let n = pw * ph;
+    let mean_dn = mean_dn.get(..n)?;
+    let plane_codes = saturated_then_codes.get_mut(..n)?;
+    if n == 0 {
+        return None;
+    }
+    let saturated_px: &[u8] = plane_codes;
+    let valid = mean_dn
+        .iter()
+        .zip(saturated_px)
+        .filter(|&(&m, &s)| usable(m, s))
+        .count();
+    if valid * 1000 < MIN_VALID_PERMILLE * n {
+        return None;
+    }
+    // Residuals around the frame's median level keep the sums small in `f32`.
+    let level = {
+        let hi = u32::from(u16::MAX);
+        select(|| mean_dn.iter().map(|&m| u32::from(m)), n / 2, hi) as f32
+    };
+    let plane = (pw, ph);
+    let (bw, bh) = (pw.div_ceil(BLOCK_CELLS), ph.div_ceil(BLOCK_CELLS));
+    // A block: the mean of its cells and its centre, when every cell is usable.
+    let block = |bx: usize, by: usize| -> Option<(f32, f32, f32)> {
+        let (mut sum, mut cx_sum, mut cy_sum, mut k) = (0.0f32, 0.0f32, 0.0f32, 0u32);
+        for cy in by * BLOCK_CELLS..((by + 1) * BLOCK_CELLS).min(ph) {
+            for cx in bx * BLOCK_CELLS..((bx + 1) * BLOCK_CELLS).min(pw) {
+                let i = cy * pw + cx;
+                let (m, s) = (*mean_dn.get(i)?, *saturated_px.get(i)?);
+                if !usable(m, s) {
+                    return None;
+                }
+                sum += f32::from(m) - level;
+                cx_sum += cx as f32 + 0.5;
+                cy_sum += cy as f32 + 0.5;
+                k += 1;
+            }
+        }
+        let k = k.max(1) as f32;
+        Some((sum / k, cx_sum / k, cy_sum / k))
+    };
+    let eval = |coef: &[f32; TERMS], x: f32, y: f32| -> f32 {
+        basis(x, y, plane)
+            .iter()
+            .zip(coef)
+            .map(|(b, c)| b * c)
+            .sum()
+    };
+    let mut coef = [0.0f32; TERMS];
+    // Blocks within `trim` of the last surface are fitted (all usable ones at first).
+    let mut trim = f32::INFINITY;
+    for _ in 0..FIT_ROUNDS {
+        let mut ata = [[0.0f32; TERMS]; TERMS];
+        let mut atb = [0.0f32; TERMS];
+        let mut used = 0usize;
+        for by in 0..bh {
+            for bx in 0..bw {
+                let Some((m, x, y)) = block(bx, by) else {
+                    continue;
+                };
+                if libm::fabsf(m - eval(&coef, x, y)) > trim {
+                    continue;
+                }
+                let b = basis(x, y, plane);
+                for (i, row) in ata.iter_mut().enumerate() {
+                    for (j, a) in row.iter_mut().enumerate().take(i + 1) {
+                        *a += b[i] * b[j];
+                    }
+                    atb[i] += b[i] * m;
+                }
+                used += 1;
+            }
+        }
+        if used < 3 * TERMS {
+            return None;
+        }
+        // The upper triangle mirrors the lower one (index loops: a transpose).
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..TERMS {
+            for j in i + 1..TERMS {
+                ata[i][j] = ata[j][i];
+            }
+        }
+        coef = solve(&mut ata, &atb)?;
+        let spread = robust_spread(|| {
+            (0..bh)
+                .flat_map(move |by| (0..bw).map(move |bx| (bx, by)))
+                .filter_map(|(bx, by)| {
+                    let (m, x, y) = block(bx, by)?;
+                    let r = m - eval(&coef, x, y);
+                    (libm::fabsf(r) <= trim).then_some(r)
+                })
+        });
+        trim = TRIM_K * spread;
+    }
+    // The cells' residuals: their spread (usable cells within the trim) decides.
+    let residual = |i: usize| -> f32 {
+        // `max(1)`: no division by zero (a plane of no column has no cell anyway).
+        let (cx, cy) = (i % pw.max(1), i / pw.max(1));
+        f32::from(mean_dn.get(i).copied().unwrap_or(0))
+            - level
+            - eval(&coef, cx as f32 + 0.5, cy as f32 + 0.5)
+    };
+    let usable_at = |i: usize| {
+        usable(
+            mean_dn.get(i).copied().unwrap_or(0),
+            saturated_px.get(i).copied().unwrap_or(1),
+        )
+    };
+    let spread_dn = robust_spread(|| {
+        (0..n)
+            .filter(|&i| usable_at(i))
+            .map(residual)
+            .filter(|r| libm::fabsf(*r) <= trim)
+    });
+    let sigma = sigma_dn.max(1) as f32;
+    // A NaN spread (no cell left) is no deep space either.
+    if spread_dn.is_nan() || spread_dn * 1000.0 > MAX_SPREAD_PERMILLE as f32 * sigma {
+        return None;
+    }
+    let threshold = (OUTLIER_K * spread_dn).max(sigma);
+    // A cell's code: its departure in thresholds (1..=255), 0 when it does not depart.
+    let code_of = |i: usize, saturated: u8| -> u8 {
+        let m = mean_dn.get(i).copied().unwrap_or(0);
+        let r = libm::fabsf(residual(i));
+        if usable(m, saturated) && r > threshold {
+            (r / threshold).clamp(1.0, 255.0) as u8
+        } else {
+            0
+        }
+    };
+    let outliers = (0..n)
+        .filter(|&i| code_of(i, saturated_px.get(i).copied().unwrap_or(1)) != 0)
+        .count();
+    if outliers * 1000 > MAX_OUTLIER_PERMILLE * n {
+        return None;
+    }
+    // Each cell's count is read before its code replaces it.
+    for (i, c) in plane_codes.iter_mut().enumerate() {
+        *c = code_of(i, *c);
+    }
+    Some(DeepSpace {
+        spread_dn,
+        outliers,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    /// xorshift32 noise, uniform in ±`amp` DN.
+    fn noise(seed: &mut u32, amp: f32) -> f32 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 17;
+        *seed ^= *seed << 5;
+        (*seed % 10_000) as f32 / 10_000.0 * 2.0 * amp - amp
+    }
+
+    /// A 41×31 cell plane: a radial shading (dark centre, +80 DN at the corners) on a
+    /// 1 000 DN pedestal with cell noise, and optionally a 6×5-cell target +40 DN.
+    fn plane(target: bool, clouds: bool) -> (Vec<u16>, Vec<u8>) {
+        let (pw, ph) = (41usize, 31usize);
+        let mut seed = 0x1234_5678u32;
+        let mut mean = Vec::new();
+        for cy in 0..ph {
+            for cx in 0..pw {
+                let (u, v) = (
+                    cx as f32 / pw as f32 * 2.0 - 1.0,
+                    cy as f32 / ph as f32 * 2.0 - 1.0,
+                );
+                let mut m = 1000.0 + 40.0 * (u * u + v * v) + noise(&mut seed, 0.4);
+                if target && (10..16).contains(&cx) && (8..13).contains(&cy) {
+                    m += 40.0;
+                }
+                if clouds {
+                    // Cloud cells: ±60 DN patches every few cells.
+                    m += 60.0 * libm::sinf(cx as f32 * 1.3) * libm::cosf(cy as f32 * 0.9);
+                }
+                mean.push(m.round() as u16);
+            }
+        }
+        let sat = std::vec![0u8; pw * ph];
+        (mean, sat)
+    }
+
+    /// Deep space with a target: the surface takes the shading, exactly the target's
+    /// 30 cells depart.
+    #[test]
+    fn the_target_departs_from_a_shaded_sky() {
+        let (mean, sat) = plane(true, false);
+        let mut codes = sat.clone();
+        let seen = deep_space_codes(&mean, &mut codes, (41, 31), 4).expect("deep space");
+        assert_eq!(seen.outliers, 30);
+        for cy in 0..31 {
+            for cx in 0..41 {
+                let want = (10..16).contains(&cx) && (8..13).contains(&cy);
+                assert_eq!(codes[cy * 41 + cx] != 0, want, "cell ({cx}, {cy})");
+            }
+        }
+        assert!(seen.spread_dn < 0.6 * 4.0, "{seen:?}");
+    }
+
+    /// Without a target nothing departs; clouds are not deep space; a frame clipped
+    /// at 0 has nothing to fit; short planes are no answer.
+    #[test]
+    fn no_target_clouds_and_clipped_frames() {
+        let (mean, sat) = plane(false, false);
+        let mut codes = sat.clone();
+        let seen = deep_space_codes(&mean, &mut codes, (41, 31), 4).expect("deep space");
+        assert_eq!(seen.outliers, 0);
+        assert!(codes.iter().all(|&c| c == 0));
+        // Not deep space: the saturated counts stay (here 7 in every cell).
+        let (mean, _) = plane(true, true);
+        let mut counts = std::vec![7u8; mean.len()];
+        assert_eq!(deep_space_codes(&mean, &mut counts, (41, 31), 4), None);
+        assert!(counts.iter().all(|&c| c == 7));
+        let mut counts = std::vec![0u8; mean.len()];
+        assert_eq!(deep_space_codes(&mean, &mut counts, (41, 31), 4), None);
+        let clipped = std::vec![0u16; mean.len()];
+        assert_eq!(deep_space_codes(&clipped, &mut counts, (41, 31), 4), None);
+        assert_eq!(
+            deep_space_codes(&mean[..10], &mut counts, (41, 31), 4),
+            None
+        );
+    }
+
+    /// The Cholesky solve against a system with a known answer.
+    #[test]
+    fn solve_recovers_a_known_answer() {
+        let mut m = [[0.0f32; TERMS]; TERMS];
+        let want: [f32; TERMS] = core::array::from_fn(|i| i as f32 - 7.0);
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, a) in row.iter_mut().enumerate() {
+                *a = if i == j {
+                    4.0
+                } else {
+                    1.0 / (1.0 + (i + j) as f32)
+                };
+            }
+        }
+        let rhs: [f32; TERMS] =
+            core::array::from_fn(|i| (0..TERMS).map(|j| m[i][j] * want[j]).sum());
+        let x = solve(&mut m, &rhs).expect("positive definite");
+        for (a, b) in x.iter().zip(&want) {
+            assert!((a - b).abs() < 1e-4, "{x:?}");
+        }
+    }
+}
