@@ -102,9 +102,13 @@ pub struct AutoV2 {
 }
 
 /// Confidence of a box of stage 2c (deep space), ‰: its hit rate (IoU ≥ ½) on family
-/// A (seed 7001, realistic erode 2, paper and fixtures erode 0): 97 hits of 102 boxes
-/// (realistic 5 of 9, paper 6 of 7, fixtures 86 of 86), none on a no-target frame.
-pub const DEEP_SPACE_SCORE_PERMILLE: u16 = 950;
+/// A (seed 7001, realistic erode 2, paper and fixtures erode 0): 109 hits of 110 boxes
+/// (realistic 15 of 16, paper 8 of 8, fixtures 86 of 86), none on a no-target frame.
+pub const DEEP_SPACE_SCORE_PERMILLE: u16 = 990;
+
+/// Stage 2c's box side moves out to its cells' where they reach this many cells beyond
+/// the refined box: a face too faint for a boundary of `fine_sigma` σ.
+pub const DEEP_SPACE_FACE_CELLS: usize = 1;
 
 /// Stage 2c's box must be at least this many pixels on each side, else the classifier
 /// decides: a departure of one pixel across is a hot pixel.
@@ -451,6 +455,17 @@ fn prepare<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
     win: Window,
 ) -> ((usize, usize), FrameLevels) {
+    let (plane, lv) = prepare_cells(frame, work, win);
+    integrate_cells(work, plane, lv);
+    (plane, lv)
+}
+
+/// Stages 1–2 without the integrals ([`integrate_cells`]): noise, cell planes, levels.
+fn prepare_cells<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    win: Window,
+) -> ((usize, usize), FrameLevels) {
     let plane = cell_plane(win);
     // Every window of a frame that fits the capacity has at most the planes' cells;
     // `min` says so to the compiler (no panic path in the slicing below).
@@ -473,6 +488,18 @@ fn prepare<C: FrameCapacity>(
         work.col_sat.as_mut(),
     );
     let lv = levels(&work.mean_dn.as_ref()[..n], sigma, frame.max_dn());
+    (plane, lv)
+}
+
+/// Stage 2's integrals of the cell planes (the classifier's context features).
+fn integrate_cells<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane: (usize, usize),
+    lv: FrameLevels,
+) {
+    let n = (plane.0 * plane.1)
+        .min(work.mean_dn.as_ref().len())
+        .min(work.step_code.as_ref().len());
     integrate(
         &work.mean_dn.as_ref()[..n],
         &work.step_code.as_ref()[..n],
@@ -485,7 +512,6 @@ fn prepare<C: FrameCapacity>(
             edges: work.edges.as_mut(),
         },
     );
-    (plane, lv)
 }
 
 /// A fitted logistic model's P, ‰: the logistic of `bias + Σ feature · weight`, weights
@@ -558,8 +584,9 @@ impl AutoV2 {
         work: &mut AutoV2Work<C>,
         win: Window,
     ) -> Detection {
-        // Stages 1–2: noise, cell planes, levels, integrals.
-        let (plane8, lv) = prepare(frame, work, win);
+        // Stages 1–2: noise, cell planes, levels (the integrals after stage 2c, which
+        // uses their plane as scratch).
+        let (plane8, lv) = prepare_cells(frame, work, win);
         work.winner = None;
         work.blob = None;
         work.blob_won = false;
@@ -584,6 +611,7 @@ impl AutoV2 {
                 return d;
             }
         }
+        integrate_cells(work, plane8, lv);
         // Stage 3: classify the cells; codes 1..=255 for target cells (the score
         // above the cell threshold, in quarter units of log-odds), 0 otherwise.
         let cell_score = i32::from(self.cell_score);
@@ -734,11 +762,13 @@ impl AutoV2 {
             .min(work.labels8.as_ref().len())
             .min(work.mean_dn.as_ref().len());
         // `labels4` holds the cells' saturated counts (stage 1) and takes the codes.
+        // `sum` (the integrals', filled after this stage) holds the residuals.
         let seen = smooth::deep_space_codes(
             &work.mean_dn.as_ref()[..n8],
             &mut work.labels4.as_mut()[..n8],
             plane8,
             lv.sigma,
+            work.sum.as_mut(),
         )?;
         let next = label_edge_cells(
             &work.labels4.as_ref()[..n8],
@@ -749,6 +779,14 @@ impl AutoV2 {
             &mut work.comps,
         );
         let (root, w8) = choose_target(&work.comps, next, plane8, 0)?;
+        // A component of weakly departing cells alone is no target.
+        let has_seed = work.labels8.as_ref()[..n8]
+            .iter()
+            .zip(&work.labels4.as_ref()[..n8])
+            .any(|(&l, &c)| l != 0 && c > smooth::WEAK_CODE && work.comps.find(l) == root);
+        if !has_seed {
+            return None;
+        }
         // A component on the window's border may be the Earth's disc in a corner (the
         // rest of the frame deep space): the classifier, trained on such frames, decides.
         let on_border = w8.x0 == 0
@@ -974,23 +1012,51 @@ impl AutoV2 {
             clean: false,
         };
         let (roi, edge_px) = outline(frame, &gate, &region, noise, tau, saturated, &counts);
-        // Without a boundary inside the gate, the winner's cells are the box (stage
-        // 2c's cells are no box: a departure without an outline is the shading's).
-        let roi = roi.or_else(|| {
-            if space {
-                return None;
+        // Cells of the window to frame pixels, cut to the window.
+        let px =
+            |c: usize, origin: usize, len: usize| (origin + (c * cells::CELL_PX).min(len)) as u16;
+        let cells_box = Roi {
+            x0: px(usize::from(w8.x0), win.x0, win.w),
+            y0: px(usize::from(w8.y0), win.y0, win.h),
+            x1: px(usize::from(w8.x_last) + 1, win.x0, win.w),
+            y1: px(usize::from(w8.y_last) + 1, win.y0, win.h),
+        };
+        let roi = match (roi, space) {
+            // Without a boundary inside the gate, the winner's cells are the box (stage
+            // 2c's cells are no box: a departure without an outline is the shading's).
+            (None, false) => Some(cells_box),
+            (None, true) => None,
+            (Some(r), false) => Some(r),
+            // Stage 2c: a face too faint for a boundary of `fine_sigma` σ still departs
+            // at the cells' level (its cells joined the component).
+            // A side moves to the cells' when they reach at least
+            // `DEEP_SPACE_FACE_CELLS` cells beyond it (a face, not the cells' rounding).
+            (Some(r), true) => {
+                let reach = (DEEP_SPACE_FACE_CELLS * cells::CELL_PX) as u16;
+                Some(Roi {
+                    x0: if cells_box.x0 + reach <= r.x0 {
+                        cells_box.x0
+                    } else {
+                        r.x0
+                    },
+                    y0: if cells_box.y0 + reach <= r.y0 {
+                        cells_box.y0
+                    } else {
+                        r.y0
+                    },
+                    x1: if cells_box.x1 >= r.x1 + reach {
+                        cells_box.x1
+                    } else {
+                        r.x1
+                    },
+                    y1: if cells_box.y1 >= r.y1 + reach {
+                        cells_box.y1
+                    } else {
+                        r.y1
+                    },
+                })
             }
-            // Cells of the window to frame pixels, cut to the window.
-            let px = |c: usize, origin: usize, len: usize| {
-                (origin + (c * cells::CELL_PX).min(len)) as u16
-            };
-            Some(Roi {
-                x0: px(usize::from(w8.x0), win.x0, win.w),
-                y0: px(usize::from(w8.y0), win.y0, win.h),
-                x1: px(usize::from(w8.x_last) + 1, win.x0, win.w),
-                y1: px(usize::from(w8.y_last) + 1, win.y0, win.h),
-            })
-        });
+        };
         // Stage 6: the whole body, grown from the winner's cells over cells hotter or
         // colder than the ring around them (`labels4` is free after the refinement).
         // A saturated blob is a whole target already (stage 8 cuts it).

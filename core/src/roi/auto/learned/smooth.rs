@@ -20,7 +20,7 @@
 //! planes are `auto-v2`'s. Cost: [`FIT_ROUNDS`] passes over ≤ 330 blocks (15 basis
 //! terms, 120 products each) and two over the cells.
 
-use super::order::select;
+use super::order::select_binned;
 
 /// Degree of the background surface: 4 fits the real dark frame's shading, whose
 /// corners rise faster than a paraboloid (family A: degree 2 leaves the corners as
@@ -42,6 +42,11 @@ pub const FIT_ROUNDS: usize = 4;
 /// Trimming threshold, robust σ of the block residuals (3: a Gaussian keeps 99.7 %).
 const TRIM_K: f32 = 3.0;
 
+/// A round whose blocks' spread is beyond this many times the deep-space limit ends the
+/// stage (cloud texture: later rounds trim outliers, they do not halve the texture's
+/// spread); the answers on family A are those without the early end.
+const EARLY_EXIT_FACTOR: f32 = 8.0;
+
 /// The cells' robust residual spread must be at most this share of the pixel noise
 /// σ, ‰, for the window to be deep space: family A's deep-space frames 200–440 ‰,
 /// its Earth frames 810 ‰ and more (5th percentile).
@@ -50,6 +55,14 @@ pub const MAX_SPREAD_PERMILLE: u32 = 600;
 /// A cell departs from the surface (a target cell) beyond this many spreads (and at
 /// least one pixel σ).
 pub const OUTLIER_K: f32 = 6.0;
+
+/// A cell departing beyond this many spreads (and half a pixel σ) but not beyond
+/// [`OUTLIER_K`] joins a target's cells it touches (a fainter face of the target):
+/// code [`WEAK_CODE`]; a component of such cells alone is no target.
+pub const WEAK_K: f32 = 3.0;
+
+/// The code of a weakly departing cell; target cells' codes are above it.
+pub const WEAK_CODE: u8 = 1;
 
 /// More than this share of departing cells, ‰, and the surface is no background model
 /// (a target over a third of the frame leaves too few cells to fit).
@@ -138,16 +151,15 @@ fn solve(m: &mut [[f32; TERMS]; TERMS], rhs: &[f32; TERMS]) -> Option<[f32; TERM
     Some(x)
 }
 
-/// The robust spread (MAD × 1.4826) of `residuals()` (DN), from their median in
-/// 1/16 DN.
-fn robust_spread<I: Iterator<Item = f32>>(residuals: impl Fn() -> I) -> f32 {
-    let n = residuals().count();
+/// The robust spread (MAD × 1.4826) of the `n` values of `residuals()` (DN), from
+/// their median in 1/16 DN; infinite for no value.
+fn robust_spread<I: Iterator<Item = f32>>(n: usize, residuals: impl Fn() -> I) -> f32 {
     if n == 0 {
         return f32::INFINITY;
     }
     let code = |r: f32| (libm::fabsf(r) * RESIDUAL_SCALE).min(u32::MAX as f32 / 2.0) as u32;
     let hi = residuals().map(code).max().unwrap_or(0);
-    let mad = select(|| residuals().map(code), n / 2, hi);
+    let mad = select_binned(|| residuals().map(code), n / 2, hi);
     MAD_TO_SIGMA * (mad as f32 + 0.5) / RESIDUAL_SCALE
 }
 
@@ -168,88 +180,117 @@ pub struct DeepSpace {
 
 /// Stage 2c on the cell plane `(pw, ph)` (`mean_dn` and, in `saturated_then_codes`,
 /// the saturated counts as the cell pass left them; pixel noise `sigma_dn`): when the
-/// window is deep space, overwrites the counts with the target cells' codes (1..=255:
-/// the departure in thresholds, 0 elsewhere) and returns what it saw; `None` (the
-/// counts untouched) when it is not deep space or the fit fails. Slices shorter than
-/// the plane: `None`.
+/// window is deep space, overwrites the counts with the target cells' codes (above
+/// [`WEAK_CODE`]: 1 + the departure in thresholds; [`WEAK_CODE`] for a weak departure;
+/// 0 elsewhere) and returns what it saw; `None` (the counts untouched) when it is not
+/// deep space or the fit fails. `scratch` (≥ one entry per cell) holds the residuals
+/// (`f32` bits) so each is computed once. Slices shorter than the plane: `None`.
 pub fn deep_space_codes(
     mean_dn: &[u16],
     saturated_then_codes: &mut [u8],
     (pw, ph): (usize, usize),
     sigma_dn: u32,
+    scratch: &mut [u32],
 ) -> Option<DeepSpace> {
     let n = pw * ph;
     let mean_dn = mean_dn.get(..n)?;
     let plane_codes = saturated_then_codes.get_mut(..n)?;
+    let scratch = scratch.get_mut(..n)?;
     if n == 0 {
         return None;
     }
     let saturated_px: &[u8] = plane_codes;
-    let valid = mean_dn
-        .iter()
-        .zip(saturated_px)
-        .filter(|&(&m, &s)| usable(m, s))
-        .count();
+    let usable_at = |i: usize| {
+        usable(
+            mean_dn.get(i).copied().unwrap_or(0),
+            saturated_px.get(i).copied().unwrap_or(1),
+        )
+    };
+    let valid = (0..n).filter(|&i| usable_at(i)).count();
     if valid * 1000 < MIN_VALID_PERMILLE * n {
         return None;
     }
     // Residuals around the frame's median level keep the sums small in `f32`.
-    let level = {
-        let hi = u32::from(u16::MAX);
-        select(|| mean_dn.iter().map(|&m| u32::from(m)), n / 2, hi) as f32
-    };
+    let level = select_binned(|| mean_dn.iter().map(|&m| u32::from(m)), n / 2, 65_535) as f32;
     let plane = (pw, ph);
+    let sigma = sigma_dn.max(1) as f32;
+    let limit = MAX_SPREAD_PERMILLE as f32 * sigma / 1000.0;
     let (bw, bh) = (pw.div_ceil(BLOCK_CELLS), ph.div_ceil(BLOCK_CELLS));
-    // A block: the mean of its cells and its centre, when every cell is usable.
-    let block = |bx: usize, by: usize| -> Option<(f32, f32, f32)> {
-        let (mut sum, mut cx_sum, mut cy_sum, mut k) = (0.0f32, 0.0f32, 0.0f32, 0u32);
-        for cy in by * BLOCK_CELLS..((by + 1) * BLOCK_CELLS).min(ph) {
-            for cx in bx * BLOCK_CELLS..((bx + 1) * BLOCK_CELLS).min(pw) {
-                let i = cy * pw + cx;
-                let (m, s) = (*mean_dn.get(i)?, *saturated_px.get(i)?);
-                if !usable(m, s) {
-                    return None;
+    let nb = bw * bh;
+    // The blocks: their mean (NaN when a cell is not usable) in `scratch[..nb]`, their
+    // residual around the last surface in `scratch[nb..2nb]` (2 nb ≤ n + 2 pw: the
+    // last row of blocks may be half a row of cells; `get`: no panic path).
+    let centre = |b: usize, cells: usize| {
+        let c0 = b * BLOCK_CELLS;
+        let k = (c0 + BLOCK_CELLS).min(cells).saturating_sub(c0).max(1);
+        c0 as f32 + k as f32 / 2.0
+    };
+    for by in 0..bh {
+        for bx in 0..bw {
+            let (mut sum, mut k, mut ok) = (0.0f32, 0u32, true);
+            for cy in by * BLOCK_CELLS..((by + 1) * BLOCK_CELLS).min(ph) {
+                for cx in bx * BLOCK_CELLS..((bx + 1) * BLOCK_CELLS).min(pw) {
+                    let i = cy * pw + cx;
+                    ok &= usable_at(i);
+                    sum += f32::from(mean_dn.get(i).copied().unwrap_or(0)) - level;
+                    k += 1;
                 }
-                sum += f32::from(m) - level;
-                cx_sum += cx as f32 + 0.5;
-                cy_sum += cy as f32 + 0.5;
-                k += 1;
+            }
+            let m = if ok { sum / k.max(1) as f32 } else { f32::NAN };
+            if let Some(slot) = scratch.get_mut(by * bw + bx) {
+                *slot = m.to_bits();
             }
         }
-        let k = k.max(1) as f32;
-        Some((sum / k, cx_sum / k, cy_sum / k))
-    };
-    let eval = |coef: &[f32; TERMS], x: f32, y: f32| -> f32 {
-        basis(x, y, plane)
-            .iter()
-            .zip(coef)
-            .map(|(b, c)| b * c)
-            .sum()
-    };
+    }
+    if 2 * nb > n {
+        // A plane of one row or column of cells: too small to fit.
+        return None;
+    }
+    let (blocks, rest) = scratch.split_at_mut(nb);
+    let residuals = rest.get_mut(..nb)?;
+    residuals.fill(0f32.to_bits());
     let mut coef = [0.0f32; TERMS];
     // Blocks within `trim` of the last surface are fitted (all usable ones at first).
     let mut trim = f32::INFINITY;
+    let basis_of = |b: usize| basis(centre(b % bw, pw), centre(b / bw, ph), plane);
+    // The normal equations of every usable block (the lower triangle).
+    let (mut ata_all, mut atb_all, mut used_all) = ([[0.0f32; TERMS]; TERMS], [0.0f32; TERMS], 0);
+    for (b, &m) in blocks.iter().enumerate() {
+        let m = f32::from_bits(m);
+        if !m.is_nan() {
+            accumulate(&mut ata_all, &mut atb_all, &basis_of(b), m, 1.0);
+            used_all += 1;
+        }
+    }
+    // The fitted blocks' count and index sums of the last round: the same set again
+    // gives the same surface (the rounds have converged).
+    let mut last_set = None;
     for _ in 0..FIT_ROUNDS {
-        let mut ata = [[0.0f32; TERMS]; TERMS];
-        let mut atb = [0.0f32; TERMS];
-        let mut used = 0usize;
-        for by in 0..bh {
-            for bx in 0..bw {
-                let Some((m, x, y)) = block(bx, by) else {
-                    continue;
-                };
-                if libm::fabsf(m - eval(&coef, x, y)) > trim {
-                    continue;
+        let set = blocks.iter().zip(residuals.iter()).enumerate().fold(
+            (0usize, 0u64, 0u64),
+            |(k, s1, s2), (b, (&m, &r))| {
+                let (m, r) = (f32::from_bits(m), f32::from_bits(r));
+                if m.is_nan() || libm::fabsf(r) > trim {
+                    (k, s1, s2)
+                } else {
+                    (k + 1, s1 + b as u64, s2 + (b * b) as u64)
                 }
-                let b = basis(x, y, plane);
-                for (i, row) in ata.iter_mut().enumerate() {
-                    for (j, a) in row.iter_mut().enumerate().take(i + 1) {
-                        *a += b[i] * b[j];
-                    }
-                    atb[i] += b[i] * m;
-                }
-                used += 1;
+            },
+        );
+        if last_set == Some(set) {
+            break;
+        }
+        last_set = Some(set);
+        // The normal equations of this round's blocks: all usable blocks' less the
+        // trimmed ones' (few: the target's), not a sum over the kept ones again.
+        let (mut ata, mut atb, mut used) = (ata_all, atb_all, used_all);
+        for (b, (&m, &r)) in blocks.iter().zip(residuals.iter()).enumerate() {
+            let (m, r) = (f32::from_bits(m), f32::from_bits(r));
+            if m.is_nan() || libm::fabsf(r) <= trim {
+                continue;
             }
+            accumulate(&mut ata, &mut atb, &basis_of(b), -m, -1.0);
+            used -= 1;
         }
         if used < 3 * TERMS {
             return None;
@@ -262,67 +303,101 @@ pub fn deep_space_codes(
             }
         }
         coef = solve(&mut ata, &atb)?;
-        let spread = robust_spread(|| {
-            (0..bh)
-                .flat_map(move |by| (0..bw).map(move |bx| (bx, by)))
-                .filter_map(|(bx, by)| {
-                    let (m, x, y) = block(bx, by)?;
-                    let r = m - eval(&coef, x, y);
-                    (libm::fabsf(r) <= trim).then_some(r)
-                })
-        });
+        let mut kept = 0usize;
+        for (b, (&m, r)) in blocks.iter().zip(residuals.iter_mut()).enumerate() {
+            let m = f32::from_bits(m);
+            let fit = eval(&coef, centre(b % bw, pw), centre(b / bw, ph), plane);
+            let res = m - fit;
+            kept += usize::from(!res.is_nan() && libm::fabsf(res) <= trim);
+            *r = res.to_bits();
+        }
+        let within = |r: &u32| {
+            let r = f32::from_bits(*r);
+            (!r.is_nan() && libm::fabsf(r) <= trim).then_some(r)
+        };
+        let spread = robust_spread(kept, || residuals.iter().filter_map(within));
+        // Far beyond the limit after a round (clouds): no later round comes back.
+        if spread > EARLY_EXIT_FACTOR * limit {
+            return None;
+        }
         trim = TRIM_K * spread;
     }
-    // The cells' residuals: their spread (usable cells within the trim) decides.
-    let residual = |i: usize| -> f32 {
-        // `max(1)`: no division by zero (a plane of no column has no cell anyway).
+    // The cells' residuals (NaN where not usable); their spread within the trim decides.
+    for (i, slot) in scratch.iter_mut().enumerate() {
         let (cx, cy) = (i % pw.max(1), i / pw.max(1));
-        f32::from(mean_dn.get(i).copied().unwrap_or(0))
-            - level
-            - eval(&coef, cx as f32 + 0.5, cy as f32 + 0.5)
+        let r = if usable_at(i) {
+            f32::from(mean_dn.get(i).copied().unwrap_or(0))
+                - level
+                - eval(&coef, cx as f32 + 0.5, cy as f32 + 0.5, plane)
+        } else {
+            f32::NAN
+        };
+        *slot = r.to_bits();
+    }
+    let within = |r: &u32| {
+        let r = f32::from_bits(*r);
+        (!r.is_nan() && libm::fabsf(r) <= trim).then_some(r)
     };
-    let usable_at = |i: usize| {
-        usable(
-            mean_dn.get(i).copied().unwrap_or(0),
-            saturated_px.get(i).copied().unwrap_or(1),
-        )
-    };
-    let spread_dn = robust_spread(|| {
-        (0..n)
-            .filter(|&i| usable_at(i))
-            .map(residual)
-            .filter(|r| libm::fabsf(*r) <= trim)
-    });
-    let sigma = sigma_dn.max(1) as f32;
+    let kept = scratch.iter().filter_map(within).count();
+    let spread_dn = robust_spread(kept, || scratch.iter().filter_map(within));
     // A NaN spread (no cell left) is no deep space either.
-    if spread_dn.is_nan() || spread_dn * 1000.0 > MAX_SPREAD_PERMILLE as f32 * sigma {
+    if spread_dn.is_nan() || spread_dn > limit {
         return None;
     }
     let threshold = (OUTLIER_K * spread_dn).max(sigma);
-    // A cell's code: its departure in thresholds (1..=255), 0 when it does not depart.
-    let code_of = |i: usize, saturated: u8| -> u8 {
-        let m = mean_dn.get(i).copied().unwrap_or(0);
-        let r = libm::fabsf(residual(i));
-        if usable(m, saturated) && r > threshold {
-            (r / threshold).clamp(1.0, 255.0) as u8
+    let weak = (WEAK_K * spread_dn).max(0.5 * sigma).min(threshold);
+    // A cell's code from its residual (NaN: not usable, 0).
+    let code_of = |r: u32| -> u8 {
+        let r = libm::fabsf(f32::from_bits(r));
+        if r.is_nan() {
+            0
+        } else if r > threshold {
+            (1.0 + r / threshold).clamp(2.0, 255.0) as u8
+        } else if r > weak {
+            WEAK_CODE
         } else {
             0
         }
     };
-    let outliers = (0..n)
-        .filter(|&i| code_of(i, saturated_px.get(i).copied().unwrap_or(1)) != 0)
-        .count();
+    let outliers = scratch.iter().filter(|&&r| code_of(r) > WEAK_CODE).count();
     if outliers * 1000 > MAX_OUTLIER_PERMILLE * n {
         return None;
     }
-    // Each cell's count is read before its code replaces it.
-    for (i, c) in plane_codes.iter_mut().enumerate() {
-        *c = code_of(i, *c);
+    for (c, &r) in plane_codes.iter_mut().zip(scratch.iter()) {
+        *c = code_of(r);
     }
     Some(DeepSpace {
         spread_dn,
         outliers,
     })
+}
+
+/// Adds `sign` · basis basisᵀ to the lower triangle of `ata` and `m` · basis to `atb`
+/// (`m` carries the sign too).
+fn accumulate(
+    ata: &mut [[f32; TERMS]; TERMS],
+    atb: &mut [f32; TERMS],
+    basis: &[f32; TERMS],
+    m: f32,
+    sign: f32,
+) {
+    for (i, (row, t)) in ata.iter_mut().zip(atb.iter_mut()).enumerate() {
+        let bi = sign * basis[i];
+        for (a, &bj) in row.iter_mut().zip(basis).take(i + 1) {
+            *a += bi * bj;
+        }
+        *t += basis[i] * m;
+    }
+}
+
+/// The surface of coefficients `coef` at cell coordinates `(x, y)` (DN above the
+/// frame's median level).
+fn eval(coef: &[f32; TERMS], x: f32, y: f32, plane: (usize, usize)) -> f32 {
+    basis(x, y, plane)
+        .iter()
+        .zip(coef)
+        .map(|(b, c)| b * c)
+        .sum()
 }
 
 #[cfg(test)]
@@ -371,8 +446,10 @@ mod tests {
     #[test]
     fn the_target_departs_from_a_shaded_sky() {
         let (mean, sat) = plane(true, false);
+        let mut scratch = std::vec![0u32; mean.len()];
         let mut codes = sat.clone();
-        let seen = deep_space_codes(&mean, &mut codes, (41, 31), 4).expect("deep space");
+        let seen =
+            deep_space_codes(&mean, &mut codes, (41, 31), 4, &mut scratch).expect("deep space");
         assert_eq!(seen.outliers, 30);
         for cy in 0..31 {
             for cx in 0..41 {
@@ -388,21 +465,32 @@ mod tests {
     #[test]
     fn no_target_clouds_and_clipped_frames() {
         let (mean, sat) = plane(false, false);
+        let mut scratch = std::vec![0u32; mean.len()];
         let mut codes = sat.clone();
-        let seen = deep_space_codes(&mean, &mut codes, (41, 31), 4).expect("deep space");
+        let seen =
+            deep_space_codes(&mean, &mut codes, (41, 31), 4, &mut scratch).expect("deep space");
         assert_eq!(seen.outliers, 0);
         assert!(codes.iter().all(|&c| c == 0));
         // Not deep space: the saturated counts stay (here 7 in every cell).
         let (mean, _) = plane(true, true);
         let mut counts = std::vec![7u8; mean.len()];
-        assert_eq!(deep_space_codes(&mean, &mut counts, (41, 31), 4), None);
+        assert_eq!(
+            deep_space_codes(&mean, &mut counts, (41, 31), 4, &mut scratch),
+            None
+        );
         assert!(counts.iter().all(|&c| c == 7));
         let mut counts = std::vec![0u8; mean.len()];
-        assert_eq!(deep_space_codes(&mean, &mut counts, (41, 31), 4), None);
-        let clipped = std::vec![0u16; mean.len()];
-        assert_eq!(deep_space_codes(&clipped, &mut counts, (41, 31), 4), None);
         assert_eq!(
-            deep_space_codes(&mean[..10], &mut counts, (41, 31), 4),
+            deep_space_codes(&mean, &mut counts, (41, 31), 4, &mut scratch),
+            None
+        );
+        let clipped = std::vec![0u16; mean.len()];
+        assert_eq!(
+            deep_space_codes(&clipped, &mut counts, (41, 31), 4, &mut scratch),
+            None
+        );
+        assert_eq!(
+            deep_space_codes(&mean[..10], &mut counts, (41, 31), 4, &mut scratch),
             None
         );
     }
