@@ -19,7 +19,7 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
+use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, Roi, SCORE_FULL_PERMILLE};
 
@@ -106,8 +106,10 @@ fn body_params() -> impl Strategy<Value = BodyParams> {
 /// the classifier is meant to find).
 fn frame(seed: u64, w: usize, h: usize, bits: u8) -> Img {
     let mut rng = Rng::new(seed);
-    if rng.below(3) > 0 {
-        return any_frame(&mut rng, w, h, bits);
+    match rng.below(4) {
+        0 => return shaded_sky(&mut rng, w, h, bits),
+        1 | 2 => return any_frame(&mut rng, w, h, bits),
+        _ => {}
     }
     let max = u64::from(max_dn(bits));
     let (bx, by) = (rng.urange(0, w - 1), rng.urange(0, h - 1));
@@ -123,6 +125,36 @@ fn frame(seed: u64, w: usize, h: usize, bits: u8) -> Img {
                 (ramp + rng.below(max / 64 + 1)).min(max) as u16
             };
             *img.at(x, y) = v;
+        }
+    }
+    img
+}
+
+/// Deep space as a camera shows it (what stage 2c takes for deep space): a pedestal,
+/// a radial shading of random depth, noise, a few hot pixels and a block of random
+/// contrast (none, hotter or colder than the sky), any of it clipped to the bit depth.
+fn shaded_sky(rng: &mut Rng, w: usize, h: usize, bits: u8) -> Img {
+    let max = u64::from(max_dn(bits));
+    let pedestal = rng.below(max / 2 + 1);
+    let shading = rng.below(max / 32 + 2) as f64;
+    let noise = rng.below(max / 256 + 2);
+    let (bx, by) = (rng.urange(0, w - 1), rng.urange(0, h - 1));
+    let (bw, bh) = (rng.urange(1, 80), rng.urange(1, 80));
+    let contrast = rng.below(64 * noise + 2) as i64 * if rng.below(2) == 0 { 1 } else { -1 };
+    let mut img = Img::constant(w, h, bits, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let u = 2.0 * x as f64 / w as f64 - 1.0;
+            let v = 2.0 * y as f64 / h as f64 - 1.0;
+            let mut dn =
+                pedestal as i64 + (shading * (u * u + v * v)) as i64 + rng.below(noise + 1) as i64;
+            if (bx..bx + bw).contains(&x) && (by..by + bh).contains(&y) {
+                dn += contrast;
+            }
+            if rng.below(2000) == 0 {
+                dn += (max / 4) as i64;
+            }
+            *img.at(x, y) = dn.clamp(0, max as i64) as u16;
         }
     }
     img
@@ -152,6 +184,10 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
             let score = if work.blob_won() {
                 prop_assert!(det.blob != BlobRule::Off, "{d:?}");
                 work.blob().expect("a blob won").score_permille()
+            } else if work.deep_space().is_some() {
+                // Stage 2c's box (deep space): its constant confidence, no blob.
+                prop_assert!(det.deep_space && work.blob().is_none(), "{d:?}");
+                DEEP_SPACE_SCORE_PERMILLE
             } else {
                 work.winner().expect("a box has a winner").score_permille()
             };
@@ -211,6 +247,22 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
     let mut bank = Box::new(Detectors::new());
     prop_assert_eq!(bank.detect(&Params::AutoV2(det), &f).unwrap(), d);
     Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(64))]
+
+    /// Shaded skies of about the full size (stage 2c's ground: many blocks to fit).
+    #[test]
+    fn shaded_skies_keep_every_invariant(
+        w in 200usize..=FRAME_WIDTH,
+        h in 150usize..=FRAME_HEIGHT,
+        bits in prop_oneof![Just(14u8), 8u8..=16],
+        seed in any::<u64>(),
+        det in params(),
+    ) {
+        check(&shaded_sky(&mut Rng::new(seed), w, h, bits), det)?;
+    }
 }
 
 proptest! {

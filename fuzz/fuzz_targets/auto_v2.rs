@@ -10,13 +10,47 @@
 //! stage on (`BodyParams::DEFAULT`) or off; when byte 2's top bit is set, bytes 9..17
 //! a tracking prior (x0, y0, x1, y1, little-endian u16: any box, cut to the frame by
 //! the detector); the rest the DN (little-endian u16, repeated to fill the frame;
-//! none: a black frame).
+//! none: a black frame). When byte 2's bit 6 is set (and there are more than 48 DN), a
+//! smooth frame instead, the ground of stage 2c (deep space): the first 48 DN are an
+//! 8 × 6 grid of levels interpolated bilinearly over the frame (kinks and steps between
+//! grid points depart from any polynomial), the rest a small periodic pattern (their
+//! top 6 bits) on top; clipped to the bit depth. Byte 8's bit 5 turns stage 2c off.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
 use tirroi_core::{Detector, Frame, Roi, SCORE_FULL_PERMILLE};
+
+/// Control points of the smooth frames across and down.
+const GRID_X: usize = 8;
+const GRID_Y: usize = 6;
+
+/// A smooth `w × h` frame from `dn` (see the input layout).
+fn smooth_frame(dn: &[u16], w: usize, h: usize, bits: u8) -> Vec<u16> {
+    let max = if bits >= 16 {
+        u16::MAX
+    } else {
+        (1u16 << bits) - 1
+    };
+    let (grid, rest) = dn.split_at(GRID_X * GRID_Y);
+    let at =
+        |gx: usize, gy: usize| f64::from(grid[gy.min(GRID_Y - 1) * GRID_X + gx.min(GRID_X - 1)]);
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let fx = x as f64 / w.max(2) as f64 * (GRID_X - 1) as f64;
+            let fy = y as f64 / h.max(2) as f64 * (GRID_Y - 1) as f64;
+            let (gx, gy) = (fx as usize, fy as usize);
+            let (tx, ty) = (fx - gx as f64, fy - gy as f64);
+            let top = at(gx, gy) * (1.0 - tx) + at(gx + 1, gy) * tx;
+            let bottom = at(gx, gy + 1) * (1.0 - tx) + at(gx + 1, gy + 1) * tx;
+            let level = top * (1.0 - ty) + bottom * ty;
+            let pattern = rest.get(i % rest.len().max(1)).map_or(0, |&v| v >> 10);
+            (level + f64::from(pattern)).min(f64::from(max)) as u16
+        })
+        .collect()
+}
 
 fuzz_target!(|data: &[u8]| {
     if data.len() < 9 {
@@ -55,9 +89,13 @@ fuzz_target!(|data: &[u8]| {
         .chunks_exact(2)
         .map(|c| u16::from_le_bytes([c[0], c[1]]))
         .collect();
-    let pixels: Vec<u16> = (0..w * h)
-        .map(|i| if dn.is_empty() { 0 } else { dn[i % dn.len()] })
-        .collect();
+    let pixels: Vec<u16> = if data[2] & 0x40 != 0 && dn.len() > GRID_X * GRID_Y {
+        smooth_frame(&dn, w, h, bits)
+    } else {
+        (0..w * h)
+            .map(|i| if dn.is_empty() { 0 } else { dn[i % dn.len()] })
+            .collect()
+    };
     let frame = Frame::new(&pixels, w, h, bits).expect("valid dimensions");
     let mut scratch = Box::new(AutoV2Scratch::new());
     let d = det.detect(&frame, &mut scratch).expect("valid parameters");

@@ -1520,6 +1520,65 @@ mod tests {
         }
     }
 
+    /// A frame of deep space as a real camera shows it: a 2 000 DN pedestal, a shading
+    /// 80 DN brighter at the corners than at the centre, noise σ ≈ 9.2 DN, optionally a
+    /// hot pixel (+3 000 DN) and a target 60 DN above the sky (a 6.5 σ face).
+    fn shaded_sky(target: bool, hot_pixel: bool) -> std::vec::Vec<u16> {
+        let mut px = blocks_frame(&[]);
+        for (i, v) in px.iter_mut().enumerate() {
+            let (x, y) = (i % FRAME_WIDTH, i / FRAME_WIDTH);
+            let u = x as f32 / FRAME_WIDTH as f32 * 2.0 - 1.0;
+            let w = y as f32 / FRAME_HEIGHT as f32 * 2.0 - 1.0;
+            *v += (40.0 * (u * u + w * w)) as u16;
+            if target && (120..180).contains(&x) && (90..140).contains(&y) {
+                *v += 60;
+            }
+        }
+        if hot_pixel {
+            px[200 * FRAME_WIDTH + 40] += 3000;
+        }
+        px
+    }
+
+    /// Stage 2c: over a shaded sky the target's cells depart from the fitted surface
+    /// and are boxed with the stage's confidence; a sky with only a hot pixel gets no
+    /// box from the stage (1 px across); with the stage off the classifier answers.
+    #[test]
+    fn a_target_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let px = shaded_sky(true, true);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        let seen = scratch
+            .work()
+            .deep_space()
+            .expect("deep space, boxed by stage 2c");
+        assert!(seen.outliers >= 30, "{seen:?}");
+        assert_eq!(d.score_permille, DEEP_SPACE_SCORE_PERMILLE);
+        let r = d.roi.expect("the target's box");
+        assert!(r.iou(&Roi::new(120, 90, 180, 140)) > 0.9, "{r:?}");
+        assert_eq!(
+            d,
+            det.detect(&frame, &mut scratch).unwrap(),
+            "same answer twice"
+        );
+        // The hot pixel alone: not the stage's box.
+        let px = shaded_sky(false, true);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_none(), "{d:?}");
+        // The stage off: the classifier's answer, not the stage's.
+        let off = AutoV2 {
+            deep_space: false,
+            ..det
+        };
+        let px = shaded_sky(true, true);
+        let frame = Frame::reference(&px).unwrap();
+        off.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_none());
+    }
+
     #[test]
     fn detections_are_bounded_and_repeatable() {
         let det = AutoV2::default();
