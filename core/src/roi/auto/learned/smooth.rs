@@ -246,12 +246,15 @@ pub fn deep_space_codes(
         // A plane of one row or column of cells: too small to fit.
         return None;
     }
-    let (blocks, rest) = scratch.split_at_mut(nb);
+    // `split_at_mut_checked`: no panic path (2 nb ≤ n = the scratch's length here).
+    let (blocks, rest) = scratch.split_at_mut_checked(nb)?;
     let residuals = rest.get_mut(..nb)?;
     residuals.fill(0f32.to_bits());
     let mut coef = [0.0f32; TERMS];
     // Blocks within `trim` of the last surface are fitted (all usable ones at first).
     let mut trim = f32::INFINITY;
+    // `max(1)`: no division by zero (a plane has a block per row).
+    let bw = bw.max(1);
     let basis_of = |b: usize| basis(centre(b % bw, pw), centre(b / bw, ph), plane);
     // The normal equations of every usable block (the lower triangle).
     let (mut ata_all, mut atb_all, mut used_all) = ([[0.0f32; TERMS]; TERMS], [0.0f32; TERMS], 0);
