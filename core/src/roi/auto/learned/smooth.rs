@@ -11,14 +11,20 @@
 //! the classifier (trained on our renders, which miss most low-contrast targets over a
 //! shaded sky) is not asked.
 //!
-//! The constants were chosen on family A (realistic seed 7001: of its 36 radiometry
-//! frames at close range over deep space, the classifier's mean IoU is 0.19); a
-//! prototype (`docs/detectors.md` § Session 29) put the Earth frames' spread at
-//! 0.8–5.4 σ (5th–95th percentile) and deep space's at 0.2–0.44 σ.
+//! Chosen on family A (realistic seed 7001: of its 36 radiometry frames at close range
+//! over deep space, the classifier's mean IoU is 0.19; `docs/detectors.md` § Session
+//! 29): the degree, the spread limit (a prototype put the Earth frames' spread at
+//! 0.8–5.4 σ, 5th–95th percentile, deep space's at 0.2–0.44 σ) and [`WEAK_K`]. Set by
+//! their reason and not varied: [`TRIM_K`], [`OUTLIER_K`], [`FIT_ROUNDS`],
+//! [`BLOCK_CELLS`], [`MAX_OUTLIER_PERMILLE`], [`MIN_VALID_PERMILLE`].
 //!
-//! Memory: none of its own beyond the stack (a 15×15 `f32` system, 900 B); the cell
-//! planes are `auto-v2`'s. Cost: [`FIT_ROUNDS`] passes over ≤ 330 blocks (15 basis
-//! terms, 120 products each) and two over the cells.
+//! Memory: the residuals (one `f32` per cell, then per block) in a plane the caller
+//! lends (`auto-v2`'s integrals, made after this stage); on the stack two 15×15 `f32`
+//! systems and the solver's copy (about 2.2 KB measured on the M7). Cost: one pass
+//! over ≤ 336 blocks for every block's normal equations (120 products each), then per
+//! round the trimmed blocks' less and a residual pass, ≤ [`FIT_ROUNDS`] rounds; three
+//! passes over the cells; medians by 64-bin histogram passes: 1.3 M instructions on
+//! the Cortex-M7 where it runs in full (docs/flight.md § Session 29).
 
 use super::order::select_binned;
 
@@ -30,6 +36,22 @@ pub const DEGREE: usize = 4;
 /// Terms of the polynomial of degree [`DEGREE`] in two variables.
 const TERMS: usize = (DEGREE + 1) * (DEGREE + 2) / 2;
 
+/// The powers `(i, j)` of each term, `P_i(across) · P_j(down)`, in the basis's order.
+const TERM_POWERS: [(usize, usize); TERMS] = {
+    let mut powers = [(0, 0); TERMS];
+    let (mut i, mut k) = (0, 0);
+    while i <= DEGREE {
+        let mut j = 0;
+        while j <= DEGREE - i {
+            powers[k] = (i, j);
+            k += 1;
+            j += 1;
+        }
+        i += 1;
+    }
+    powers
+};
+
 /// Cells per side of a fit block: the fit works on 2×2-cell (16×16-pixel) blocks,
 /// a quarter of the cells' products, as smooth as the shading it models.
 pub const BLOCK_CELLS: usize = 2;
@@ -40,7 +62,7 @@ pub const BLOCK_CELLS: usize = 2;
 pub const FIT_ROUNDS: usize = 4;
 
 /// Trimming threshold, robust σ of the block residuals (3: a Gaussian keeps 99.7 %).
-const TRIM_K: f32 = 3.0;
+pub const TRIM_K: f32 = 3.0;
 
 /// A round whose blocks' spread is beyond this many times the deep-space limit ends the
 /// stage (cloud texture: later rounds trim outliers, they do not halve the texture's
@@ -256,12 +278,43 @@ pub fn deep_space_codes(
     // `max(1)`: no division by zero (a plane has a block per row).
     let bw = bw.max(1);
     let basis_of = |b: usize| basis(centre(b % bw, pw), centre(b / bw, ph), plane);
-    // The normal equations of every usable block (the lower triangle).
-    let (mut ata_all, mut atb_all, mut used_all) = ([[0.0f32; TERMS]; TERMS], [0.0f32; TERMS], 0);
+    // The normal equations of every usable block (the lower triangle): those of the
+    // whole grid of blocks, a product of one-dimensional sums (the basis is a product
+    // of a polynomial across and one down), less the unusable blocks'; the right-hand
+    // side over the usable blocks.
+    let grid_sums = |count: usize, cells: usize, side: usize| {
+        let mut sums = [[0.0f32; DEGREE + 1]; DEGREE + 1];
+        for c in 0..count {
+            let p = legendre(2.0 * centre(c, cells) / side as f32 - 1.0);
+            for (row, &pi) in sums.iter_mut().zip(&p) {
+                for (a, &pk) in row.iter_mut().zip(&p) {
+                    *a += pi * pk;
+                }
+            }
+        }
+        sums
+    };
+    let (across, down) = (grid_sums(bw, pw, pw), grid_sums(bh, ph, ph));
+    let mut ata_all = [[0.0f32; TERMS]; TERMS];
+    // (`get`: the powers are at most `DEGREE`; no panic path.)
+    let at = |sums: &[[f32; DEGREE + 1]; DEGREE + 1], a: usize, b: usize| {
+        sums.get(a).and_then(|r| r.get(b)).copied().unwrap_or(0.0)
+    };
+    for (row, &(i, j)) in ata_all.iter_mut().zip(&TERM_POWERS) {
+        for (a, &(k, l)) in row.iter_mut().zip(&TERM_POWERS) {
+            *a = at(&across, i, k) * at(&down, j, l);
+        }
+    }
+    let (mut atb_all, mut used_all) = ([0.0f32; TERMS], 0);
     for (b, &m) in blocks.iter().enumerate() {
         let m = f32::from_bits(m);
-        if !m.is_nan() {
-            accumulate(&mut ata_all, &mut atb_all, &basis_of(b), m, 1.0);
+        let basis = basis_of(b);
+        if m.is_nan() {
+            accumulate(&mut ata_all, &mut atb_all, &basis, 0.0, -1.0);
+        } else {
+            for (a, &bt) in atb_all.iter_mut().zip(&basis) {
+                *a += bt * m;
+            }
             used_all += 1;
         }
     }
@@ -326,16 +379,27 @@ pub fn deep_space_codes(
         trim = TRIM_K * spread;
     }
     // The cells' residuals (NaN where not usable); their spread within the trim decides.
-    for (i, slot) in scratch.iter_mut().enumerate() {
-        let (cx, cy) = (i % pw.max(1), i / pw.max(1));
-        let r = if usable_at(i) {
-            f32::from(mean_dn.get(i).copied().unwrap_or(0))
-                - level
-                - eval(&coef, cx as f32 + 0.5, cy as f32 + 0.5, plane)
-        } else {
-            f32::NAN
-        };
-        *slot = r.to_bits();
+    // Row by row: the surface along a row is a polynomial across, its coefficients
+    // the terms' summed down the row's `P_j`.
+    for (cy, row) in scratch.chunks_mut(pw.max(1)).enumerate() {
+        let pv = legendre(2.0 * (cy as f32 + 0.5) / ph as f32 - 1.0);
+        let mut along = [0.0f32; DEGREE + 1];
+        for (&c, &(i, j)) in coef.iter().zip(&TERM_POWERS) {
+            if let (Some(a), Some(&v)) = (along.get_mut(i), pv.get(j)) {
+                *a += c * v;
+            }
+        }
+        for (cx, slot) in row.iter_mut().enumerate() {
+            let i = cy * pw + cx;
+            let r = if usable_at(i) {
+                let pu = legendre(2.0 * (cx as f32 + 0.5) / pw as f32 - 1.0);
+                let fit: f32 = along.iter().zip(&pu).map(|(a, u)| a * u).sum();
+                f32::from(mean_dn.get(i).copied().unwrap_or(0)) - level - fit
+            } else {
+                f32::NAN
+            };
+            *slot = r.to_bits();
+        }
     }
     let within = |r: &u32| {
         let r = f32::from_bits(*r);
