@@ -23,7 +23,7 @@
 //! systems and the solver's copy (about 2.2 KB measured on the M7). Cost: one pass
 //! over ≤ 336 blocks for every block's normal equations (120 products each), then per
 //! round the trimmed blocks' less and a residual pass, ≤ [`FIT_ROUNDS`] rounds; three
-//! passes over the cells; medians by 64-bin histogram passes: 1.3 M instructions on
+//! passes over the cells; medians by 64-bin histogram passes: 1.06 M instructions on
 //! the Cortex-M7 where it runs in full (docs/flight.md § Session 29).
 
 use super::order::select_binned;
