@@ -59,6 +59,14 @@ impl CellStats {
         usize::from(self.y_last) + 1
     }
 
+    /// Sides of a `(pw, ph)` cell plane the cells' box touches, 0..=4.
+    pub fn sides_touched(&self, (pw, ph): (usize, usize)) -> u8 {
+        u8::from(self.x0 == 0)
+            + u8::from(self.y0 == 0)
+            + u8::from(self.x_end() >= pw)
+            + u8::from(self.y_end() >= ph)
+    }
+
     fn add(&mut self, x: u8, y: u8, q: u32) {
         self.x0 = self.x0.min(x);
         self.y0 = self.y0.min(y);

@@ -148,6 +148,10 @@ enum Counts {
     Recount,
 }
 
+/// Relabelling step of the classifier's and stage 2c's cell codes when their cells
+/// need more labels than there are (codes are quarter units of log-odds: 2 units).
+const CELL_RELABEL_CODES: u8 = 8;
+
 /// Relabelling step of the blob's cells when they need more labels than there are
 /// (a frame strewn with clipped pixels), pixels at the top DN per cell.
 const BLOB_RELABEL_PX: u8 = 8;
@@ -406,6 +410,29 @@ fn cell_pass<C: FrameCapacity>(
     (plane, lv)
 }
 
+/// Stage 4 on the codes in `labels4` (cells from code 1): 8-connected components in
+/// `labels8`/`comps`, relabelled from a code `relabel_codes` higher when there are more
+/// than the labels; the strongest (summed code) as `(root label, its cells' box and
+/// statistics, labels used)`, `None` without one. Shared by the classifier's cells, the
+/// saturated blob's and stage 2c's.
+fn strongest_component<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane8: (usize, usize),
+    relabel_codes: u8,
+) -> Option<(u8, CellStats, usize)> {
+    let n8 = plane8.0 * plane8.1;
+    let next = label_edge_cells(
+        work.labels4.as_ref().get(..n8)?,
+        work.labels8.as_mut().get_mut(..n8)?,
+        plane8.0,
+        1,
+        relabel_codes,
+        &mut work.comps,
+    );
+    let (root, w8) = choose_target(&work.comps, next, plane8, 0)?;
+    Some((root, w8, next))
+}
+
 /// Stage 3 on prepared planes ([`prepare`]): see [`cell_pass`].
 fn classify_cells<C: FrameCapacity>(
     frame: &Frame<'_>,
@@ -641,16 +668,8 @@ impl AutoV2 {
             .min(work.mean_dn.as_ref().len())
             .min(work.step_code.as_ref().len());
         // Stage 4: components of target cells; the strongest wins.
-        let next = label_edge_cells(
-            &work.labels4.as_ref()[..n8],
-            &mut work.labels8.as_mut()[..n8],
-            plane8.0,
-            1,
-            8,
-            &mut work.comps,
-        );
         work.winner = None;
-        let Some((root, w8)) = choose_target(&work.comps, next, plane8, 0) else {
+        let Some((root, w8, next)) = strongest_component(work, plane8, CELL_RELABEL_CODES) else {
             return self
                 .blob_over(frame, work, win, plane8, lv, blob_score, 0)
                 .unwrap_or(NO_TARGET);
@@ -678,10 +697,7 @@ impl AutoV2 {
                 }
             }
         }
-        let sides = u8::from(w8.x0 == 0)
-            + u8::from(w8.y0 == 0)
-            + u8::from(w8.x_end() >= plane8.0)
-            + u8::from(w8.y_end() >= plane8.1);
+        let sides = w8.sides_touched(plane8);
         let mut code_sum = 0u32;
         {
             let labels8 = &work.labels8.as_ref()[..n8];
@@ -770,15 +786,7 @@ impl AutoV2 {
             lv.sigma,
             work.sum.as_mut(),
         )?;
-        let next = label_edge_cells(
-            &work.labels4.as_ref()[..n8],
-            &mut work.labels8.as_mut()[..n8],
-            plane8.0,
-            1,
-            8,
-            &mut work.comps,
-        );
-        let (root, w8) = choose_target(&work.comps, next, plane8, 0)?;
+        let (root, w8, next) = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
         // A component of weakly departing cells alone is no target.
         let has_seed = work.labels8.as_ref()[..n8]
             .iter()
@@ -789,11 +797,7 @@ impl AutoV2 {
         }
         // A component on the window's border may be the Earth's disc in a corner (the
         // rest of the frame deep space): the classifier, trained on such frames, decides.
-        let on_border = w8.x0 == 0
-            || w8.y0 == 0
-            || usize::from(w8.x_last) + 1 >= plane8.0
-            || usize::from(w8.y_last) + 1 >= plane8.1;
-        if on_border {
+        if w8.sides_touched(plane8) > 0 {
             return None;
         }
         let d = self.finish(
@@ -887,15 +891,7 @@ impl AutoV2 {
         if total < blob::MIN_FRAME_SATURATED_PX {
             return None;
         }
-        let next = label_edge_cells(
-            work.labels4.as_ref().get(..n8)?,
-            work.labels8.as_mut().get_mut(..n8)?,
-            plane8.0,
-            1,
-            BLOB_RELABEL_PX,
-            &mut work.comps,
-        );
-        let (root, w8) = choose_target(&work.comps, next, plane8, 0)?;
+        let (root, w8, next) = strongest_component(work, plane8, BLOB_RELABEL_PX)?;
         let marks = work.dilated4.as_mut().get_mut(..n8)?;
         for (m, &l) in marks.iter_mut().zip(work.labels8.as_ref().get(..n8)?) {
             *m = u8::from(l != 0 && work.comps.find(l) == root);
