@@ -415,6 +415,11 @@ fn cell_pass<C: FrameCapacity>(
 /// than the labels; the strongest (summed code) as `(root label, its cells' box and
 /// statistics, labels used)`, `None` without one. Shared by the classifier's cells, the
 /// saturated blob's and stage 2c's.
+///
+/// Kept out of line: inlined into `run_in` at its three call sites it cost the M7
+/// +0.29 M instructions on every embedded frame (`scripts/flight.sh`, auto-v2 mean
+/// 13.17 → 13.50 M; `run_in`'s hot loops spill more), out of line 13.21 M; x86 unchanged.
+#[inline(never)]
 fn strongest_component<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
     plane8: (usize, usize),
