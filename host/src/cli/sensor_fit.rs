@@ -44,7 +44,8 @@ pub fn run(args: &SensorFitArgs) -> Result<(), String> {
     eprintln!(
         "{name}: {}x{} area at ({}, {}); mean {:.2} DN; shading amplitude (p99-p1) {:.2} DN, \
          range {:.2} DN (min {:.2} at {:?}, max {:.2} at {:?}); columns sigma {:.3} DN rho {:.3}; \
-         rows sigma {:.3} DN rho {:.3}; pixel sigma {:.3} DN; hot {} dead {} (> {} sigma); \
+         rows sigma {:.3} DN rho {:.3}; field sigma {:.3} DN length {:.1} px (process {:.1} px); \
+         pixel sigma {:.3} DN; hot {} dead {} (> {} sigma); \
          gain {:.4} DN per W m-2 sr-1 (shutter {:.2} K, L {:.4} W m-2 sr-1)",
         area[2],
         area[3],
@@ -61,6 +62,9 @@ pub fn run(args: &SensorFitArgs) -> Result<(), String> {
         f.columns.lag1_correlation,
         f.rows.sigma_dn,
         f.rows.lag1_correlation,
+        f.field.sigma_dn,
+        f.field.correlation_length_px,
+        cal.field_process.length_px,
         f.pixels.sigma_dn,
         f.pixels.hot_count,
         f.pixels.dead_count,

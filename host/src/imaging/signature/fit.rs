@@ -1,5 +1,6 @@
 //! The fit of a sensor signature on one frame: smooth shading (a 2-D polynomial),
-//! column and row patterns, outlier (hot and dead) pixels, and the per-pixel residual.
+//! column and row patterns, a cell-scale field, outlier (hot and dead) pixels, and the
+//! per-pixel residual.
 //!
 //! The same code measures the calibration frame and the synthetic realisations, so the
 //! tests compare like with like.
@@ -24,6 +25,17 @@ pub const OUTLIER_K_SIGMA: f64 = 5.0;
 /// the second (so that hot pixels do not pull the smooth surface).
 const SHADING_CLIP_K_SIGMA: f64 = 5.0;
 
+/// Largest lag of the residual's autocorrelation the field is fitted on, px. On the
+/// real dark frame the autocorrelation of what the shading and line fits leave falls to
+/// 0 near 48 px (lag 48: 0.0 of lag 1's; lag 32: 0.40), so 1..=48 spans the whole
+/// correlated part without fitting the negative lobe the polynomial leaves beyond.
+pub const FIELD_MAX_LAG_PX: usize = 48;
+
+/// Candidate correlation lengths of the field's fit, log-spaced from 0.5 px to the
+/// frame's larger side: 400 steps are 1.5 % apart on a 328-px frame (finer than the
+/// fit's scatter between realisations, about 5 %).
+const FIELD_LENGTH_STEPS: usize = 400;
+
 /// MAD → σ of a Gaussian.
 const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 
@@ -41,6 +53,8 @@ pub struct FrameFit {
     pub columns: LinePattern,
     /// Row pattern: the median of each row of the residual less the column pattern.
     pub rows: LinePattern,
+    /// The spatially correlated part of what is left (cell-scale structure).
+    pub field: FieldPattern,
     /// The per-pixel residual and its outliers.
     pub pixels: PixelResidual,
 }
@@ -76,6 +90,22 @@ pub struct LinePattern {
     pub sigma_dn: f64,
     /// Lag-1 autocorrelation of the per-line values (neighbouring columns or rows).
     pub lag1_correlation: f64,
+}
+
+/// The correlated part of the residual after shading, column and row patterns: a
+/// Gaussian autocorrelation C(L) = σ²·exp(−(L/ℓ)²) fitted by least squares to the
+/// residual's autocorrelation at lags 1..=[`FIELD_MAX_LAG_PX`] along rows and columns
+/// (lag 0 holds the white per-pixel part as well, so it is left out). On the real dark
+/// frame this is structure at 10–50 px that a detector's 8-px cells see as a 1-σ
+/// texture over deep space.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldPattern {
+    /// σ of the field, DN (0 when the residual is uncorrelated).
+    pub sigma_dn: f64,
+    /// Correlation length ℓ, px (the lag at which the correlation is 1/e), as measured
+    /// after the shading and line fits (which take the field's longest scales out).
+    pub correlation_length_px: f64,
 }
 
 /// The residual after shading, column and row patterns.
@@ -168,24 +198,13 @@ pub fn fit_frame(
     let smooth = eval_poly(&coeffs, width, height);
     let residual: Vec<f64> = frame.iter().zip(&smooth).map(|(v, s)| v - s).collect();
 
-    // Column pattern, then rows of what is left.
-    let col: Vec<f64> = (0..width)
-        .map(|x| median((0..height).map(|y| residual[y * width + x]).collect()))
-        .collect();
-    let row: Vec<f64> = (0..height)
-        .map(|y| {
-            median(
-                (0..width)
-                    .map(|x| residual[y * width + x] - col[x])
-                    .collect(),
-            )
-        })
-        .collect();
+    let (col, row) = line_medians(&residual, width, height);
     let e: Vec<f64> = (0..n)
         .map(|i| residual[i] - col[i % width] - row[i / width])
         .collect();
     let sigma = robust_sigma(&e);
     let thr = OUTLIER_K_SIGMA * sigma;
+    let field = fit_field(&e, width, height, thr);
     let mut hot: Vec<f64> = e.iter().copied().filter(|&v| v > thr).collect();
     let mut dead: Vec<f64> = e.iter().copied().filter(|&v| v < -thr).collect();
     hot.sort_by(|a, b| b.total_cmp(a));
@@ -215,6 +234,7 @@ pub fn fit_frame(
         },
         columns: line_pattern(&col),
         rows: line_pattern(&row),
+        field,
         pixels: PixelResidual {
             sigma_dn: sigma,
             outlier_k_sigma: OUTLIER_K_SIGMA,
@@ -231,6 +251,110 @@ pub fn fit_frame(
             residual_dn: residual,
         },
     ))
+}
+
+/// The residual's field: autocorrelation of `e` clipped at ±`clip_dn` (so outliers do not
+/// weigh), averaged over the row and column directions at each lag, and the Gaussian
+/// [`FieldPattern`] that fits it best (σ² in closed form for each candidate ℓ).
+pub fn fit_field(e: &[f64], width: usize, height: usize, clip_dn: f64) -> FieldPattern {
+    let acf = autocorrelation(e, width, height, clip_dn);
+    let none = FieldPattern {
+        sigma_dn: 0.0,
+        correlation_length_px: 0.0,
+    };
+    let top = width.max(height) as f64;
+    let mut best: Option<(f64, f64, f64)> = None;
+    for k in 0..=FIELD_LENGTH_STEPS {
+        let l = 0.5 * (top / 0.5).powf(k as f64 / FIELD_LENGTH_STEPS as f64);
+        let (mut cg, mut gg) = (0.0, 0.0);
+        for (lag, &c) in acf.iter().enumerate().skip(1) {
+            let g = (-(lag as f64 / l).powi(2)).exp();
+            cg += c * g;
+            gg += g * g;
+        }
+        if gg <= 0.0 {
+            continue;
+        }
+        let s2 = cg / gg;
+        let sse: f64 = acf
+            .iter()
+            .enumerate()
+            .skip(1)
+            .map(|(lag, &c)| (c - s2 * (-(lag as f64 / l).powi(2)).exp()).powi(2))
+            .sum();
+        if best.is_none_or(|(b, _, _)| sse < b) {
+            best = Some((sse, s2, l));
+        }
+    }
+    match best {
+        Some((_, s2, l)) if s2 > 0.0 => FieldPattern {
+            sigma_dn: s2.sqrt(),
+            correlation_length_px: l,
+        },
+        _ => none,
+    }
+}
+
+/// Autocorrelation (covariance, DN²) of the mean-removed `e` clipped at ±`clip_dn`, at
+/// lags 0..=min([`FIELD_MAX_LAG_PX`], side − 1), the mean of the row and column
+/// directions.
+pub fn autocorrelation(e: &[f64], width: usize, height: usize, clip_dn: f64) -> Vec<f64> {
+    let c: Vec<f64> = e.iter().map(|v| v.clamp(-clip_dn, clip_dn)).collect();
+    let m = c.iter().sum::<f64>() / c.len().max(1) as f64;
+    let c: Vec<f64> = c.iter().map(|v| v - m).collect();
+    let lags = FIELD_MAX_LAG_PX.min(width.min(height).saturating_sub(1));
+    (0..=lags)
+        .map(|lag| {
+            let (mut sx, mut sy) = (0.0, 0.0);
+            for y in 0..height {
+                let row = &c[y * width..(y + 1) * width];
+                sx += row.iter().zip(&row[lag..]).map(|(a, b)| a * b).sum::<f64>();
+                if y + lag < height {
+                    let below = &c[(y + lag) * width..(y + lag + 1) * width];
+                    sy += row.iter().zip(below).map(|(a, b)| a * b).sum::<f64>();
+                }
+            }
+            let nx = (height * (width - lag)) as f64;
+            let ny = (width * (height - lag)) as f64;
+            0.5 * (sx / nx + sy / ny)
+        })
+        .collect()
+}
+
+/// The column pattern (the median of each column of `residual`) and the row pattern
+/// (the median of each row less the column pattern), as [`fit_frame`] takes them out.
+pub fn line_medians(residual: &[f64], width: usize, height: usize) -> (Vec<f64>, Vec<f64>) {
+    let col: Vec<f64> = (0..width)
+        .map(|x| median((0..height).map(|y| residual[y * width + x]).collect()))
+        .collect();
+    let row: Vec<f64> = (0..height)
+        .map(|y| {
+            median(
+                (0..width)
+                    .map(|x| residual[y * width + x] - col[x])
+                    .collect(),
+            )
+        })
+        .collect();
+    (col, row)
+}
+
+/// Takes out of `v` (a `width × height` map, row-major) what [`fit_frame`] would fit
+/// as shading and line patterns (one least-squares pass: the map has no outliers), so
+/// that a synthetic field is left as the fit sees a real one.
+///
+/// # Errors
+/// A message when the shading fit is singular.
+pub fn remove_fitted_parts(v: &mut [f64], width: usize, height: usize) -> Result<(), String> {
+    let coeffs = fit_poly(v, width, height, &vec![true; v.len()])?;
+    for (x, s) in v.iter_mut().zip(eval_poly(&coeffs, width, height)) {
+        *x -= s;
+    }
+    let (col, row) = line_medians(v, width, height);
+    for (i, x) in v.iter_mut().enumerate() {
+        *x -= col[i % width] + row[i / width];
+    }
+    Ok(())
 }
 
 /// σ and lag-1 autocorrelation of a sequence.
@@ -269,7 +393,7 @@ pub fn robust_sigma(v: &[f64]) -> f64 {
 ///
 /// The normal matrix is built from the moments Σ xᵖyᵠ (p, q ≤ 2D) accumulated row by
 /// row, about 14 operations per pixel instead of the 120 of the outer products.
-fn fit_poly(frame: &[f64], w: usize, h: usize, keep: &[bool]) -> Result<Vec<f64>, String> {
+pub fn fit_poly(frame: &[f64], w: usize, h: usize, keep: &[bool]) -> Result<Vec<f64>, String> {
     const P: usize = 2 * SHADING_DEGREE + 1;
     let xp: Vec<[f64; P]> = (0..w).map(|x| powers(norm_coord(x as f64, w))).collect();
     // m[p][q] = Σ xᵖyᵠ; v[p][q] = Σ xᵖyᵠ·frame (p + q ≤ D).

@@ -1,8 +1,8 @@
 //! The camera's own signature, calibrated on a real frame: what a detector meets on
 //! every frame of the Hayabusa2 TIR after its on-board shutter correction.
 //!
-//! - [`fit`]: the measurement (smooth shading, column and row patterns, hot and dead
-//!   pixels, per-pixel residual) of one frame;
+//! - [`fit`]: the measurement (smooth shading, column and row patterns, the cell-scale
+//!   field, hot and dead pixels, per-pixel residual) of one frame;
 //! - [`Calibration`]: the fitted numbers of the real deep-space frame
 //!   `dark_20180629_083003.fit` with the camera gain that turns them into radiance,
 //!   committed as `host/assets/sensor/hayabusa2-tir-dark.toml` (written by
@@ -12,13 +12,25 @@
 //!   the renderer adds to any readout.
 //!
 //! **Model** (DN of the real camera's L1 product, per pixel i at column x, row y):
-//! `DN_i = α·(S(x − dx, y − dy) − S̄) + c_x + r_y + p_i + o_i`, with S the fitted
+//! `DN_i = α·(S(x − dx, y − dy) − S̄) + c_x + r_y + f_i + p_i + o_i`, with S the fitted
 //! polynomial shading, α and (dx, dy) a modest per-realisation variation
 //! ([`SHADING_AMPLITUDE_VARIATION`], [`SHADING_SHIFT_PX`]), c and r AR(1) processes with
 //! the fitted σ and lag-1 correlation (their degree-4 polynomial part removed, as the
-//! shading fit absorbs it), p a white per-pixel residual and o the hot/dead outliers
+//! shading fit absorbs it), f a Gaussian-correlated field (below), p a white per-pixel
+//! residual and o the hot/dead outliers
 //! (a Poisson count with the fitted mean at random places, amplitudes drawn from the
 //! fitted ones).
+//!
+//! **Field.** What the shading and line fits leave on the real frame is not white: its
+//! autocorrelation holds 0.37 of its variance at lags 1–8 px and falls to 0 near 48 px
+//! (`fit::FieldPattern`: σ 2.3 DN, ℓ 32 px as measured), so 8-px cell means scatter
+//! by 2.2 DN where white pixels would give 0.4. f is white noise blurred by a Gaussian
+//! of σ = ℓ_p/2 (autocorrelation exp(−(L/ℓ_p)²)), less what the fit would take out as
+//! shading and lines ([`fit::remove_fitted_parts`]), scaled to the fitted σ. The fits
+//! shorten a long field's apparent length, so ℓ_p is found by simulation when the
+//! calibration is made ([`FieldProcess`]). f is put in the offset, not the gain: one
+//! frame cannot tell which, and as an offset it is there over deep space, where a
+//! detector must not take it for a target.
 //!
 //! **Gain residual.** One shutter-differenced frame cannot separate a pixel's gain from
 //! its offset: its value is g_i·(L_space − L_shutter). Writing g_i = g·(1 + δ_i), the
@@ -88,7 +100,33 @@ pub struct Calibration {
     pub gain: GainCalibration,
     /// The fitted numbers, DN of the source frame.
     pub fit: FrameFit,
+    /// The cell-scale field's generating process, found by simulation.
+    pub field_process: FieldProcess,
 }
+
+/// The generating length of the signature's field (module docs, "Field"): the
+/// correlation length ℓ_p of the Gaussian-correlated field whose realisations on the
+/// fitted area, after the shading and line fits, show the measured length
+/// `fit.field.correlation_length_px` (mean over [`FIELD_PROCESS_SEEDS`] fixed seeds,
+/// bisection on ln ℓ_p).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldProcess {
+    /// ℓ_p, px (0 without a field).
+    pub length_px: f64,
+}
+
+/// Fixed seeds the field's generating length is matched over: two realisations halve
+/// the scatter of one (about 5 % in the measured length) at twice the cost.
+const FIELD_PROCESS_SEEDS: u64 = 2;
+
+/// Bisection steps on ln ℓ_p over [0.5 px, the area's larger side]: 12 halvings of
+/// 6.5 octaves leave 0.1 % (far below the 5 % scatter of the measurement itself).
+const FIELD_PROCESS_STEPS: usize = 12;
+
+/// Salt of the field's random stream (its own, so that a seed's other parts are those
+/// of a signature without the field).
+const FIELD_SEED_SALT: u64 = 0x6669_656c_6453_6967;
 
 /// Provenance of a calibration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -178,11 +216,12 @@ impl Calibration {
         }
     }
 
-    /// Fixed per-pixel residual σ, DN: the fitted σ less the temporal noise in
-    /// quadrature (0 if the fit is below it).
+    /// Fixed per-pixel (white) residual σ, DN: the fitted σ less the field's and the
+    /// temporal noise in quadrature (0 if the fit is below them).
     pub fn fixed_pixel_sigma_dn(&self) -> f64 {
         let s = self.fit.pixels.sigma_dn;
-        (s * s - TEMPORAL_NOISE_DN * TEMPORAL_NOISE_DN)
+        let f = self.fit.field.sigma_dn;
+        (s * s - f * f - TEMPORAL_NOISE_DN * TEMPORAL_NOISE_DN)
             .max(0.0)
             .sqrt()
     }
@@ -243,6 +282,9 @@ impl Calibration {
                 shutter_radiance_w_m2_sr: l_sh,
                 dn_per_w_m2_sr: -fit.shading.min_dn / l_sh,
             },
+            field_process: FieldProcess {
+                length_px: field_process_length(&fit).map_err(|e| format!("{file}: field: {e}"))?,
+            },
             fit,
         })
     }
@@ -290,6 +332,13 @@ impl Calibration {
             f.rows.lag1_correlation,
         );
         let sp = self.fixed_pixel_sigma_dn();
+        let field = scaled_field(
+            width,
+            height,
+            self.field_process.length_px,
+            f.field.sigma_dn,
+            seed ^ FIELD_SEED_SALT,
+        );
         let c = &f.shading.coefficients_dn;
         let mean = f.shading.mean_dn;
         let mut offset = vec![0.0f64; n];
@@ -306,7 +355,7 @@ impl Calibration {
                 let p: f64 = sp * rng.sample::<f64, _>(StandardNormal);
                 let i = y * width + x;
                 pixel[i] = p;
-                offset[i] = alpha * (s - mean) + col_x + row_y + p;
+                offset[i] = alpha * (s - mean) + col_x + row_y + field[i] + p;
             }
         }
         // Outliers: a Poisson count per kind with the fitted mean scaled to the area.
@@ -388,6 +437,105 @@ impl SensorSignature {
         }
         Ok(())
     }
+}
+
+/// A realisation of the field: white noise blurred by a Gaussian of σ = `length_px`/2,
+/// less what the fit takes out as shading and lines, scaled to σ `sigma_dn` (all zero
+/// for a length or σ of 0, or a shading fit that fails on a degenerate size).
+fn scaled_field(width: usize, height: usize, length_px: f64, sigma_dn: f64, seed: u64) -> Vec<f64> {
+    let n = width * height;
+    if !(length_px > 0.0 && sigma_dn > 0.0) {
+        return vec![0.0; n];
+    }
+    let mut v = processed_field(width, height, length_px, seed);
+    let sd = (v.iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64).sqrt();
+    let k = if sd > 0.0 { sigma_dn / sd } else { 0.0 };
+    v.iter_mut().for_each(|x| *x *= k);
+    v
+}
+
+/// Unit white noise for `seed` blurred by a Gaussian of σ = `length_px`/2 and passed
+/// through [`fit::remove_fitted_parts`] (zeros if that fails).
+fn processed_field(width: usize, height: usize, length_px: f64, seed: u64) -> Vec<f64> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let white: Vec<f64> = (0..width * height)
+        .map(|_| rng.sample(StandardNormal))
+        .collect();
+    let mut v = gaussian_blur(&white, width, height, 0.5 * length_px);
+    if fit::remove_fitted_parts(&mut v, width, height).is_err() {
+        v.iter_mut().for_each(|x| *x = 0.0);
+    }
+    v
+}
+
+/// Separable Gaussian blur of σ `sigma_px` (kernel to 3σ, mirrored at the edges).
+fn gaussian_blur(v: &[f64], width: usize, height: usize, sigma_px: f64) -> Vec<f64> {
+    let r = (3.0 * sigma_px).ceil().max(1.0) as usize;
+    let kernel: Vec<f64> = (0..=2 * r)
+        .map(|k| (-0.5 * ((k as f64 - r as f64) / sigma_px).powi(2)).exp())
+        .collect();
+    let total: f64 = kernel.iter().sum();
+    let kernel: Vec<f64> = kernel.iter().map(|k| k / total).collect();
+    // Index i − r of a line of n, mirrored at both ends (any distance).
+    let mirror = |i: usize, n: usize| -> usize {
+        let p = (i + 2 * n * (r / n + 1) - r) % (2 * n);
+        if p >= n { 2 * n - 1 - p } else { p }
+    };
+    let mut rows = vec![0.0; v.len()];
+    let mut padded = vec![0.0; width + 2 * r];
+    for (line, out) in v.chunks_exact(width).zip(rows.chunks_exact_mut(width)) {
+        for (i, p) in padded.iter_mut().enumerate() {
+            *p = line[mirror(i, width)];
+        }
+        for (o, win) in out.iter_mut().zip(padded.windows(kernel.len())) {
+            *o = win.iter().zip(&kernel).map(|(a, k)| a * k).sum();
+        }
+    }
+    let mut out = vec![0.0; v.len()];
+    for (y, dst) in out.chunks_exact_mut(width).enumerate() {
+        for (k, &w) in kernel.iter().enumerate() {
+            let src = mirror(y + k, height) * width;
+            let line = &rows[src..src + width];
+            dst.iter_mut().zip(line).for_each(|(o, &s)| *o += w * s);
+        }
+    }
+    out
+}
+
+/// The field's generating length ℓ_p for a fit ([`FieldProcess`]): the ℓ_p whose
+/// processed realisations on the fit's area show, on average over
+/// [`FIELD_PROCESS_SEEDS`], the fitted correlation length. 0 without a field.
+///
+/// # Errors
+/// A message when the area is too small for a field fit (under 16 px a side).
+fn field_process_length(f: &FrameFit) -> Result<f64, String> {
+    let target = f.field.correlation_length_px;
+    if !(target > 0.0 && f.field.sigma_dn > 0.0) {
+        return Ok(0.0);
+    }
+    let (w, h) = (f.width, f.height);
+    if w < 16 || h < 16 {
+        return Err(format!("{w} × {h} area: expected at least 16 × 16"));
+    }
+    let measured = |length_px: f64| {
+        (0..FIELD_PROCESS_SEEDS)
+            .map(|k| {
+                let v = processed_field(w, h, length_px, FIELD_SEED_SALT ^ k);
+                fit::fit_field(&v, w, h, f64::INFINITY).correlation_length_px
+            })
+            .sum::<f64>()
+            / FIELD_PROCESS_SEEDS as f64
+    };
+    let (mut lo, mut hi) = (0.5f64.ln(), (w.max(h) as f64).ln());
+    for _ in 0..FIELD_PROCESS_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if measured(mid.exp()) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok((0.5 * (lo + hi)).exp())
 }
 
 /// An AR(1) sequence with lag-1 correlation `lag1`, less its least-squares polynomial

@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use rayon::prelude::*;
+
 use super::fit::fit_frame;
 use super::*;
 use crate::imaging::fits::read_fits;
@@ -122,11 +124,118 @@ fn realisations_keep_the_shading_and_column_pattern_within_10_percent() {
     assert!(worst_col < 0.10, "{worst_col}");
 }
 
+/// Spread of the `cell`×`cell` block means of what the fit leaves (shading and lines
+/// out, outliers clipped at 5 robust σ), DN: the texture a detector's cells see.
+fn cell_mean_spread_dn(frame: &[f64], w: usize, h: usize, cell: usize) -> f64 {
+    let (fit, maps) = fit_frame(frame, w, h).unwrap();
+    let mut e = maps.residual_dn.clone();
+    let (col, row) = fit::line_medians(&e, w, h);
+    let clip = fit.pixels.outlier_k_sigma * fit.pixels.sigma_dn;
+    for (i, v) in e.iter_mut().enumerate() {
+        *v = (*v - col[i % w] - row[i / w]).clamp(-clip, clip);
+    }
+    let means: Vec<f64> = (0..h / cell)
+        .flat_map(|cy| (0..w / cell).map(move |cx| (cx, cy)))
+        .map(|(cx, cy)| {
+            let s: f64 = (0..cell)
+                .flat_map(|y| (0..cell).map(move |x| (x, y)))
+                .map(|(x, y)| e[(cy * cell + y) * w + cx * cell + x])
+                .sum();
+            s / (cell * cell) as f64
+        })
+        .collect();
+    let m = means.iter().sum::<f64>() / means.len() as f64;
+    (means.iter().map(|v| (v - m).powi(2)).sum::<f64>() / means.len() as f64).sqrt()
+}
+
+/// The cell-scale field: realisations, fitted as the real frame is, show its σ and
+/// correlation length, and 8-px (and 16-px) cell means scatter as the real frame's do
+/// (2.2 DN; white pixels alone would give 0.4 DN, the signature without the field did).
+#[test]
+fn realisations_keep_the_cell_scale_field_within_10_percent() {
+    let cal = Calibration::hayabusa2_tir().unwrap();
+    let [_, _, w, h] = cal.source.area_px;
+    let want = &cal.fit.field;
+    assert!(
+        want.sigma_dn > 1.0 && want.correlation_length_px > 8.0,
+        "{want:?}"
+    );
+    let runs = 8;
+    let (mut sigma, mut length, mut cell8, mut cell16) = (0.0, 0.0, 0.0, 0.0);
+    for seed in 0..runs {
+        let frame = synthetic_frame(&cal, 500 + seed);
+        let (fit, _) = fit_frame(&frame, w, h).unwrap();
+        sigma += fit.field.sigma_dn / runs as f64;
+        length += fit.field.correlation_length_px / runs as f64;
+        cell8 += cell_mean_spread_dn(&frame, w, h, 8) / runs as f64;
+        cell16 += cell_mean_spread_dn(&frame, w, h, 16) / runs as f64;
+    }
+    let Some((img, _)) = real_frame() else {
+        // Without the real frame: the fitted numbers in the committed file.
+        assert!(
+            (sigma / want.sigma_dn - 1.0).abs() < 0.10,
+            "{sigma} vs {want:?}"
+        );
+        return;
+    };
+    let real = area_of(&img);
+    let (real8, real16) = (
+        cell_mean_spread_dn(&real, w, h, 8),
+        cell_mean_spread_dn(&real, w, h, 16),
+    );
+    eprintln!(
+        "field: sigma {sigma:.3} DN (real {:.3}), length {length:.1} px (real {:.1}); \
+         8-px cell means {cell8:.3} DN (real {real8:.3}), 16-px {cell16:.3} DN (real {real16:.3})",
+        want.sigma_dn, want.correlation_length_px
+    );
+    assert!(
+        (sigma / want.sigma_dn - 1.0).abs() < 0.10,
+        "{sigma} vs {want:?}"
+    );
+    assert!(
+        (length / want.correlation_length_px - 1.0).abs() < 0.10,
+        "{length} vs {want:?}"
+    );
+    assert!((cell8 / real8 - 1.0).abs() < 0.10, "{cell8} vs {real8}");
+    assert!((cell16 / real16 - 1.0).abs() < 0.10, "{cell16} vs {real16}");
+}
+
+/// The field fit against a known answer: a field made with a known Gaussian
+/// autocorrelation and no fitting in the way is found back.
+#[test]
+fn field_fit_recovers_a_known_gaussian_field() {
+    let (w, h) = (256, 256);
+    let mut sigma = 0.0;
+    let mut length = 0.0;
+    for seed in 0..4 {
+        // σ 3 DN, ℓ 6 px: short against the frame, so no fit shortens it.
+        let v: Vec<f64> = gaussian_blur(
+            &{
+                let mut rng = Pcg64Mcg::seed_from_u64(seed);
+                (0..w * h)
+                    .map(|_| rng.sample::<f64, _>(StandardNormal))
+                    .collect::<Vec<_>>()
+            },
+            w,
+            h,
+            3.0,
+        );
+        let sd = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+        let v: Vec<f64> = v.iter().map(|x| 3.0 * x / sd).collect();
+        let f = fit::fit_field(&v, w, h, f64::INFINITY);
+        sigma += f.sigma_dn / 4.0;
+        length += f.correlation_length_px / 4.0;
+    }
+    assert!((sigma / 3.0 - 1.0).abs() < 0.05, "{sigma}");
+    assert!((length / 6.0 - 1.0).abs() < 0.05, "{length}");
+}
+
 #[test]
 fn hot_pixel_count_within_10_percent_over_100_realisations() {
     let cal = Calibration::hayabusa2_tir().unwrap();
     let [_, _, w, h] = cal.source.area_px;
-    let total: usize = (0..100)
+    let total: usize = (0..100u64)
+        .into_par_iter()
         .map(|seed| {
             fit_frame(&synthetic_frame(&cal, 1000 + seed), w, h)
                 .unwrap()
