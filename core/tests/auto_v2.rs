@@ -19,7 +19,9 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE};
+use tirroi_core::roi::auto::learned::{
+    AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE,
+};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, Roi, SCORE_FULL_PERMILLE};
 
@@ -50,6 +52,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
         ],
         prior(),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
             |(
@@ -62,6 +65,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 blob,
                 prior,
                 deep_space,
+                small_target,
             )| {
                 AutoV2 {
                     prior,
@@ -73,6 +77,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     prescreen,
                     blob,
                     deep_space,
+                    small_target,
                 }
             },
         )
@@ -185,9 +190,14 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 prop_assert!(det.blob != BlobRule::Off, "{d:?}");
                 work.blob().expect("a blob won").score_permille()
             } else if work.deep_space().is_some() {
-                // Stage 2c's box (deep space): its constant confidence, no blob.
+                // Stage 2c's or 2d's box (deep space): its constant confidence, no blob.
                 prop_assert!(det.deep_space && work.blob().is_none(), "{d:?}");
-                DEEP_SPACE_SCORE_PERMILLE
+                if d.score_permille == SMALL_TARGET_SCORE_PERMILLE {
+                    prop_assert!(det.small_target, "{d:?}");
+                    SMALL_TARGET_SCORE_PERMILLE
+                } else {
+                    DEEP_SPACE_SCORE_PERMILLE
+                }
             } else {
                 work.winner().expect("a box has a winner").score_permille()
             };

@@ -14,7 +14,8 @@
 //! smooth frame instead, the ground of stage 2c (deep space): the first 48 DN are an
 //! 8 × 6 grid of levels interpolated bilinearly over the frame (kinks and steps between
 //! grid points depart from any polynomial), the rest a small periodic pattern (their
-//! top 6 bits) on top; clipped to the bit depth. Byte 8's bit 5 turns stage 2c off.
+//! top 6 bits) on top; clipped to the bit depth. Byte 8's bit 5 turns stage 2c off,
+//! bit 4 stage 2d on.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -79,6 +80,7 @@ fuzz_target!(|data: &[u8]| {
         },
         prescreen: data[8] & 0x40 == 0,
         deep_space: data[8] & 0x20 == 0,
+        small_target: data[8] & 0x10 != 0,
         blob: match data[3] / 64 {
             0 => BlobRule::Off,
             1 => BlobRule::Always,
