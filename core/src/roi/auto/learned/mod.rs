@@ -788,6 +788,12 @@ impl AutoV2 {
     /// with [`DEEP_SPACE_SCORE_PERMILLE`]; `None` (the classifier decides) when the
     /// window is not deep space, no cell departs or the refinement finds no boundary
     /// (a far target within a cell's noise; the shading's own departures).
+    ///
+    /// Kept out of line (it runs once per frame): inlined into `run_in`, stage 2d's
+    /// code (off by default) cost the M7 +0.22 M instructions on every embedded frame
+    /// (`scripts/flight.sh`, `auto-v2` mean 13.21 → 13.43 M; `run_in`'s hot loops
+    /// spill more); out of line 13.13 M.
+    #[inline(never)]
     fn deep_space_stage<C: FrameCapacity>(
         &self,
         frame: &Frame<'_>,
