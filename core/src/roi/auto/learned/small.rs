@@ -12,15 +12,19 @@
 //! the noise of a 3×3 mean; only a warmer departure counts (nothing in the scene is
 //! colder than deep space). The strongest z of at least [`MIN_Z`] wins, where at least
 //! [`MIN_BRIGHT_PX`] pixels of the 3×3 stand [`BRIGHT_SIGMA`] σ above the ring (a single
-//! hot pixel, the real camera's signature, does not). Its box grows from the peak's 3×3
-//! while a pixel just outside a side stands [`BOX_SIGMA`] σ above the ring (and
+//! hot pixel, the real camera's signature, does not). Its box grows from the centre of
+//! that 3×3 while a pixel just outside a side stands [`BOX_SIGMA`] σ above the ring (and
 //! [`BOX_PEAK_FRACTION`] of the peak): over deep space nothing but the target does, so
 //! its fainter faces are kept (a cut at half the peak dropped them); a box that reaches
 //! [`SEARCH_HALF_PX`] from the peak is no small target.
 //!
-//! Chosen on family A (`docs/detectors.md` § Session 30): [`MIN_Z`]. Set by their
-//! reason: the ring (inside the field's scale, outside a 12-px target's blur), the
-//! bright-pixel rule and the search square.
+//! Compared on family A (`docs/detectors.md` § Session 30): the grown box against a
+//! half-maximum cut (which dropped the fainter faces), [`BOX_SIGMA`] 3/4/6 and
+//! [`BOX_PEAK_FRACTION`] 4/8/16 (within 0.001 but 6σ), [`MIN_Z`] 6–12 (the same boxes:
+//! not binding). Set by their reason: those values, the ring (inside the field's
+//! scale, outside a 12-px target's blur), the bright-pixel rule and the reach.
+//! Off by default (`AutoV2::small_target`): it boxes line-like defects of the real
+//! camera (a bright band at the frame's left edge) that our renders lack.
 //!
 //! Memory: three rows of `u32` column sums the caller lends (`auto-v2`'s integral
 //! planes, filled after this stage). Cost: per pixel three column sums updated by a
@@ -183,7 +187,7 @@ pub(crate) fn strongest_small_target(
     })
 }
 
-/// The target's box around candidate `c` (module docs): grown from the peak's 3×3 in
+/// The target's box around candidate `c` (module docs): grown from its centre pixel in
 /// the window while a pixel just outside a side (the side's span and one pixel beyond
 /// each end) departs from the ring's mean by at least [`BOX_SIGMA`] σ and 1 /
 /// [`BOX_PEAK_FRACTION`] of the peak's departure. `None` when the box reaches
