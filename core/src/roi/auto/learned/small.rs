@@ -83,7 +83,7 @@ pub struct Candidate {
     pub y: usize,
     /// Its local contrast, noise σ of a 3×3 mean (integer part).
     pub z: u32,
-    /// Sum of the ring's pixels (mean × [`RING_COUNT`]), DN.
+    /// Sum of the ring's pixels (its mean times the ring's 96 pixels), DN.
     pub ring_sum: i64,
 }
 
