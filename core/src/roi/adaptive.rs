@@ -191,13 +191,16 @@ impl Detector for Adaptive {
     }
 }
 
-fn add_row(col: &mut [u32], row: &[u16], max_dn: u16) {
+/// Adds `row` (each DN clipped to `max_dn`) to the column sums `col` (shared with
+/// `auto-v2`'s stage 2d, `learned::small`).
+pub(crate) fn add_row(col: &mut [u32], row: &[u16], max_dn: u16) {
     for (c, &v) in col.iter_mut().zip(row) {
         *c += u32::from(v.min(max_dn));
     }
 }
 
-fn sub_row(col: &mut [u32], row: &[u16], max_dn: u16) {
+/// Takes `row` (each DN clipped to `max_dn`) out of the column sums `col`.
+pub(crate) fn sub_row(col: &mut [u32], row: &[u16], max_dn: u16) {
     for (c, &v) in col.iter_mut().zip(row) {
         *c -= u32::from(v.min(max_dn));
     }

@@ -33,6 +33,7 @@
 
 use crate::frame::Frame;
 use crate::roi::Roi;
+use crate::roi::adaptive::{add_row, sub_row};
 use crate::roi::plane::Window;
 
 /// Least local contrast of a small target, in noise σ of a 3×3 mean: a Gaussian
@@ -88,22 +89,11 @@ pub struct Candidate {
 }
 
 /// Column sums over `rows` rows of the window starting at frame row `top`, into
-/// `sums[..w]`.
+/// `sums[..w]` (`adaptive`'s row adder, DN clipped to the frame's depth).
 fn column_sums(frame: &Frame<'_>, win: Window, top: usize, rows: usize, sums: &mut [u32]) {
-    sums.iter_mut().for_each(|s| *s = 0);
+    sums.fill(0);
     for y in top..top + rows {
-        for (s, &v) in sums.iter_mut().zip(win.row(frame, y)) {
-            *s += u32::from(v);
-        }
-    }
-}
-
-/// Moves the column sums of a `rows`-row band one row down: adds frame row `enter`,
-/// removes row `leave`.
-fn slide(frame: &Frame<'_>, win: Window, enter: usize, leave: usize, sums: &mut [u32]) {
-    let (add, sub) = (win.row(frame, enter), win.row(frame, leave));
-    for ((s, &a), &b) in sums.iter_mut().zip(add).zip(sub) {
-        *s = s.wrapping_add(u32::from(a)).wrapping_sub(u32::from(b));
+        add_row(sums, win.row(frame, y), frame.max_dn());
     }
 }
 
@@ -138,9 +128,16 @@ pub(crate) fn strongest_small_target(
             column_sums(frame, win, cy - m, HOLE_PX, col_hole);
             column_sums(frame, win, cy - i, INNER_PX, col_inner);
         } else {
-            slide(frame, win, cy + r, cy - r - 1, col_ring);
-            slide(frame, win, cy + m, cy - m - 1, col_hole);
-            slide(frame, win, cy + i, cy - i - 1, col_inner);
+            // Each band one row down: a row in, a row out.
+            let max_dn = frame.max_dn();
+            for (col, half) in [
+                (&mut *col_ring, r),
+                (&mut *col_hole, m),
+                (&mut *col_inner, i),
+            ] {
+                add_row(col, win.row(frame, cy + half), max_dn);
+                sub_row(col, win.row(frame, cy - half - 1), max_dn);
+            }
         }
         // Running sums along the row, centred on column c (window coordinates).
         let sum_of = |cols: &[u32], c: usize, half: usize| -> i64 {
