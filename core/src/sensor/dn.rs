@@ -115,6 +115,29 @@ impl DnMapping {
         Self::new(gain, -gain * f_min_w_m2, bits)
     }
 
+    /// Eq. 17 on a camera's measured signal: `lo` ↦ DN 0 and `hi` ↦ 2ⁿ − 1 for any
+    /// finite `lo` < `hi` (the signal's unit, W m⁻² for F). A camera ranges on what it
+    /// measures, the scene's F plus its own offset (shading, fixed pattern), which can
+    /// put the low end below 0 where the scene's F cannot be ([`Self::radiometry_auto`]).
+    ///
+    /// # Errors
+    /// [`SensorError`] unless `lo` < `hi` are finite with a span whose gain is normal,
+    /// or for a bad bit depth.
+    pub fn radiometry_auto_measured(lo: f64, hi: f64, bits: u8) -> Result<Self, SensorError> {
+        check_range("lo", lo, f64::MIN, f64::MAX, "a finite signal")?;
+        check_range("hi", hi, lo, f64::MAX, "a finite signal > lo")?;
+        let span = hi - lo;
+        if span.is_nan() || span <= 0.0 {
+            return Err(SensorError::OutOfRange {
+                name: "hi",
+                value: hi,
+                expected: "hi > lo (a signal of one level has no range)",
+            });
+        }
+        let gain = full_scale(bits) / span;
+        Self::new(gain, -gain * lo, bits)
+    }
+
     /// Radiometry mode with a fixed gain instead of Eq. 17's auto range: a real
     /// camera's read-out, DN = a·F + b with a = `dn_per_w_m2_sr`/π (F = π·L, Eq. 6) at
     /// [`FIXED_GAIN_REFERENCE_BITS`] bits, scaled by 2^(bits − 14) for another depth,
@@ -319,6 +342,26 @@ mod tests {
         assert!(DnMapping::radiometry_auto(5.0, 5.0, 14).is_err());
         assert!(DnMapping::radiometry_auto(5.0, 1.0, 14).is_err());
         assert!(DnMapping::radiometry_auto(-1.0, 1.0, 14).is_err());
+    }
+
+    #[test]
+    fn measured_range_maps_ends_below_zero_too() {
+        // A measured low end below 0 (the camera's own offset): still DN 0 to full scale.
+        let m = DnMapping::radiometry_auto_measured(-4.5, 12.0, 12).unwrap();
+        assert_eq!(m.quantise(m.dn(-4.5)), 0);
+        assert_eq!(m.quantise(m.dn(12.0)), 4095);
+        assert_eq!(m.quantise(m.dn(3.75)), 2048);
+        // Where both are allowed it is Eq. 17's map.
+        let (a, b) = (
+            DnMapping::radiometry_auto(10.0, 500.0, 14).unwrap(),
+            DnMapping::radiometry_auto_measured(10.0, 500.0, 14).unwrap(),
+        );
+        assert_eq!(a, b);
+        assert!(DnMapping::radiometry_auto_measured(1.0, 1.0, 14).is_err());
+        assert!(DnMapping::radiometry_auto_measured(2.0, 1.0, 14).is_err());
+        assert!(DnMapping::radiometry_auto_measured(f64::NAN, 1.0, 14).is_err());
+        assert!(DnMapping::radiometry_auto_measured(0.0, f64::INFINITY, 14).is_err());
+        assert!(DnMapping::radiometry_auto_measured(0.0, 1.0, 0).is_err());
     }
 
     #[test]

@@ -29,6 +29,7 @@ use super::{Kind, TestFrame, TestRecord, box_array, file_name, reference_file};
 use crate::dataset::DatasetError;
 use crate::imaging::fits::read_fits;
 use crate::imaging::image_io::FrameBuf;
+use crate::imaging::render::PurePixels;
 use crate::imaging::signature::{Calibration, SensorSignature, TIR_EFFECTIVE_AREA_PX};
 use crate::seed::splitmix64;
 use crate::world::scene::Camera;
@@ -170,7 +171,7 @@ pub fn frames(
             let camera = Camera { bits, ..camera0 };
             let out = read(
                 signal,
-                None,
+                &PurePixels::default(),
                 &ReadoutChoice {
                     camera: &camera,
                     fixed_gain: Some(cal.fixed_gain()),

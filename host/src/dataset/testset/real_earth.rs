@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use tirroi_core::Roi;
 use tirroi_core::sensor::BandRadiance;
 
-use super::composite::{ReadoutChoice, composite, pure_bounds, read};
+use super::composite::{ReadoutChoice, composite, pure_pixels, read};
 use super::targets::{TargetRender, TargetRenders};
 use super::{Kind, TestFrame, TestRecord, box_array, file_name, reference_file};
 use crate::dataset::DatasetError;
@@ -185,11 +185,11 @@ pub fn frames(
             };
             let background = earth.window_f(corner, flip);
             let signal = composite(target.as_ref(), &background)?;
-            let pure = pure_bounds(&signal, target.as_ref());
+            let pure = pure_pixels(&signal, target.as_ref());
             let camera = Camera { bits, ..camera0 };
             let out = read(
                 signal,
-                pure,
+                &pure,
                 &ReadoutChoice {
                     camera: &camera,
                     fixed_gain: fixed.then(|| cal.fixed_gain()),

@@ -40,7 +40,7 @@
 use tirroi_core::Roi;
 
 use super::earth::render_earth;
-use super::target::Range;
+use super::pure::PurePixels;
 use super::{MASK_COVERAGE, Pinhole, RenderError, RenderInput, RenderStats, Rendered};
 
 /// Narrowest ring around the truth box, px: enough pixels for a standard deviation of
@@ -212,7 +212,7 @@ pub fn signal_to_clutter(
             input.readout,
             &none,
             &mut twin,
-            &mut Range::default(),
+            &mut PurePixels::default(),
             &mut RenderStats::default(),
         )?;
         for (row, line) in twin.chunks_exact(ww).enumerate() {

@@ -4,7 +4,7 @@
 use tirroi_core::sensor::flux::{distance_compensation, view_factor_per_m2};
 use tirroi_core::sensor::{BandLut, SENSOR_AREA_M2, SensorError};
 
-use super::target::Range;
+use super::pure::PurePixels;
 use super::{
     EarthView, MASK_COVERAGE, Pinhole, Readout, RenderError, RenderStats, SAMPLES, sample_point,
 };
@@ -273,7 +273,7 @@ pub(super) fn render_earth(
     readout: Readout,
     coverage: &[f32],
     signal: &mut [f32],
-    pure: &mut Range,
+    pure: &mut PurePixels,
     stats: &mut RenderStats,
 ) -> Result<usize, RenderError> {
     let dist = norm(earth.centre_m);
@@ -366,7 +366,7 @@ pub(super) fn render_earth(
                 seen += 1;
             }
             if here == 1 && !differs && c == 0.0 {
-                pure.add(s);
+                pure.add(i, s);
             }
         }
     }

@@ -60,6 +60,7 @@ use crate::world::spacecraft::Mesh;
 mod clutter;
 mod earth;
 mod moon;
+mod pure;
 mod target;
 
 pub use clutter::{
@@ -70,7 +71,8 @@ pub use clutter::{
 use earth::render_earth;
 pub use moon::MoonView;
 use moon::render_moon;
-use target::{Range, render_target};
+pub use pure::{MEASURED_TAIL_PERMILLE, PurePixels};
+use target::render_target;
 
 /// Sub-samples per axis on a partial pixel (4 × 4 = 16 per pixel).
 pub const SUPERSAMPLES_PER_AXIS: usize = 4;
@@ -319,7 +321,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     let mut coverage = vec![0f32; n];
     let mut signal = vec![0f32; n];
     // Pure pixels (all target or all Earth) bound the radiometry range (Eq. 17).
-    let mut pure = Range::default();
+    let mut pure = PurePixels::default();
 
     let t0 = Instant::now();
     if let Some(target) = &input.target {
@@ -364,7 +366,7 @@ pub fn render(input: &RenderInput<'_>) -> Result<Rendered, RenderError> {
     }
     stats.earth_ns = t1.elapsed().as_nanos() as u64;
 
-    let out = read_out(input, signal, pure.bounds(), &mut stats)?;
+    let out = read_out(input, signal, &pure, &mut stats)?;
 
     let truth = mask_box(&coverage, cam.w);
     let truth_quarter = coverage_box(&coverage, cam.w, |c| c > QUARTER_COVERAGE);
@@ -440,8 +442,10 @@ pub struct ReadOut {
 
 /// The readout stage of [`render`] on a signal frame of `input.camera`'s size (F in
 /// W m⁻² in radiometry, q_fc in detection): the optics PSF and sensor signature of
-/// `input.sensor`, the DN map of `input.readout` (auto range over `pure`, the
-/// (min, max) signal of the frame's unmixed pixels, or the fixed gain), the noise of
+/// `input.sensor`, the DN map of `input.readout` (auto range over `pure`, the frame's
+/// unmixed pixels: the (min, max) of their signal, measured after the optics and the
+/// signature when the camera has them, [`PurePixels::measured_bounds`]; or the fixed
+/// gain), the noise of
 /// `input.noise_seed` and quantisation. The scene part of `input` (target, Earth,
 /// Moon) is not used: callers that make the signal another way (test frames over real
 /// backgrounds) read it out exactly as a rendered frame is.
@@ -452,7 +456,7 @@ pub struct ReadOut {
 pub fn read_out(
     input: &RenderInput<'_>,
     mut signal: Vec<f32>,
-    pure: Option<(f64, f64)>,
+    pure: &PurePixels,
     stats: &mut RenderStats,
 ) -> Result<ReadOut, RenderError> {
     let (w, h) = (input.camera.width, input.camera.height);
@@ -465,7 +469,8 @@ pub fn read_out(
     }
     let ts = Instant::now();
     signal = through_the_optics(input, signal)?;
-    if input.sensor.psf.is_some() || input.sensor.signature.is_some() {
+    let sensed = input.sensor.psf.is_some() || input.sensor.signature.is_some();
+    if sensed {
         stats.sensor_ns = ts.elapsed().as_nanos() as u64;
     }
 
@@ -483,7 +488,14 @@ pub fn read_out(
             // Eq. 17 over the pure pixels, with the span kept at least
             // MIN_RANGE_NETD NETDs wide (in F at the reference temperature), so a
             // near-uniform scene is not stretched until its noise fills the frame.
-            let (lo, hi) = pure.unwrap_or((0.0, 0.0));
+            // The camera ranges on what it measures: with optics or a signature, the
+            // pure pixels' signal after them (its shading and offset included).
+            let bounds = if sensed {
+                pure.measured_bounds(&signal)
+            } else {
+                pure.bounds()
+            };
+            let (lo, hi) = bounds.unwrap_or((0.0, 0.0));
             let min_span = MIN_RANGE_NETD
                 * input.camera.netd_k
                 * std::f64::consts::PI
@@ -493,10 +505,16 @@ pub fn read_out(
             let (lo, hi) = if hi - lo >= min_span && hi > lo {
                 (lo, hi)
             } else {
-                let lo = (0.5 * (lo + hi) - 0.5 * min_span).max(0.0);
+                // The scene's F is ≥ 0; a measured signal may be below (the offset).
+                let floor = if sensed { f64::MIN } else { 0.0 };
+                let lo = (0.5 * (lo + hi) - 0.5 * min_span).max(floor);
                 (lo, lo + min_span.max(f64::MIN_POSITIVE))
             };
-            DnMapping::radiometry_auto(lo, hi, bits)?
+            if sensed {
+                DnMapping::radiometry_auto_measured(lo, hi, bits)?
+            } else {
+                DnMapping::radiometry_auto(lo, hi, bits)?
+            }
         }
     };
     let g = input.gain_factor;

@@ -20,7 +20,7 @@
 use tirroi_core::sensor::flux::{distance_compensation, view_factor_per_m2};
 use tirroi_core::sensor::{BandLut, SENSOR_AREA_M2};
 
-use super::target::Range;
+use super::pure::PurePixels;
 use super::{EarthView, Pinhole, Readout, RenderError, SAMPLES, sample_point};
 use crate::world::geom::{Vec3, dot, norm, normalize, scale, sub};
 use crate::world::moon::{
@@ -55,7 +55,7 @@ pub(super) fn render_moon(
     lut: &BandLut,
     coverage: &[f32],
     signal: &mut [f32],
-    pure: &mut Range,
+    pure: &mut PurePixels,
 ) -> Result<usize, RenderError> {
     let dir = normalize(moon.dir_camera);
     let sun = normalize(moon.sun_dir_camera);
@@ -118,7 +118,7 @@ pub(super) fn render_moon(
             let mean = sum / SAMPLES as f32;
             signal[i] += (1.0 - c) * mean;
             if hits == SAMPLES && c == 0.0 {
-                pure.add(mean);
+                pure.add(i, mean);
             }
             if c < super::MASK_COVERAGE
                 && sample(cam.ray(x as f64 + 0.5, y as f64 + 0.5))?.is_some()

@@ -4,38 +4,12 @@
 use tirroi_core::sensor::SENSOR_AREA_M2;
 use tirroi_core::sensor::flux::{distance_compensation, facet_flux_w_m2};
 
+use super::pure::PurePixels;
 use super::{
     NO_FACET, Pinhole, Readout, RenderError, RenderInput, RenderStats, SAMPLES, TargetView,
     sample_point,
 };
 use crate::world::geom::{Vec3, dot, norm, scale};
-
-/// Running min/max of the pure pixels' signal.
-#[derive(Debug, Default, Clone, Copy)]
-pub(super) struct Range {
-    pub(super) lo: f32,
-    pub(super) hi: f32,
-    pub(super) any: bool,
-}
-
-impl Range {
-    pub(super) fn add(&mut self, v: f32) {
-        if !self.any {
-            *self = Range {
-                lo: v,
-                hi: v,
-                any: true,
-            };
-        } else {
-            self.lo = self.lo.min(v);
-            self.hi = self.hi.max(v);
-        }
-    }
-
-    pub(super) fn bounds(&self) -> Option<(f64, f64)> {
-        self.any.then_some((f64::from(self.lo), f64::from(self.hi)))
-    }
-}
 
 /// A facet projected to the image: vertices (u, v) and 1/z.
 #[derive(Debug, Clone, Copy)]
@@ -107,7 +81,7 @@ pub(super) fn render_target(
     input: &RenderInput<'_>,
     coverage: &mut [f32],
     signal: &mut [f32],
-    pure: &mut Range,
+    pure: &mut PurePixels,
     stats: &mut RenderStats,
 ) -> Result<(), RenderError> {
     let mesh = target.mesh;
@@ -311,7 +285,7 @@ pub(super) fn render_target(
                 coverage[o] = 1.0;
                 let s = facet_signal[centre_facet[i] as usize];
                 signal[o] = s;
-                pure.add(s);
+                pure.add(o, s);
             }
         }
     }
