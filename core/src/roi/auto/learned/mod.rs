@@ -96,9 +96,7 @@ pub struct AutoV2 {
     /// Stage 2c ([`smooth`]): a window whose cells fit a smooth surface within noise is
     /// deep space, and the cells departing from the surface are the target's (instead
     /// of the classifier's) where the refinement finds a boundary of `fine_sigma` σ in
-    /// them; such a box carries [`DEEP_SPACE_SCORE_PERMILLE`], or
-    /// [`DEEP_SPACE_BORDER_SCORE_PERMILLE`] when it touches one side of the window (two
-    /// or more: [`EARTH_MIN_SIDES`], the classifier decides). Otherwise, and when the
+    /// them; such a box carries [`DEEP_SPACE_SCORE_PERMILLE`]. Otherwise, and when the
     /// frame has a saturated blob (stage 2b decides then), the classifier decides.
     /// Default on.
     pub deep_space: bool,
@@ -116,33 +114,6 @@ pub struct AutoV2 {
 /// A (seed 7001, realistic erode 2, paper and fixtures erode 0): 109 hits of 110 boxes
 /// (realistic 15 of 16, paper 8 of 8, fixtures 86 of 86), none on a no-target frame.
 pub const DEEP_SPACE_SCORE_PERMILLE: u16 = 990;
-
-/// Confidence of a box of stage 2c whose component touches one side of the window
-/// (a target cut by the frame), ‰: its hit rate (IoU ≥ ½) on family A (seed 7001,
-/// realistic erode 2, paper and fixtures erode 0): 15 hits of 17 boxes (realistic 3 of
-/// 5, paper 2 of 2, fixtures 10 of 10), none on a no-target frame.
-pub const DEEP_SPACE_BORDER_SCORE_PERMILLE: u16 = 882;
-
-/// Sides of the window a component of stage 2c must touch to be possibly the Earth's
-/// disc, which the classifier then judges. Seen from low orbit the Earth is far larger
-/// than the frame: its limb's radius of curvature in the image is about f·tan ρ, ρ the
-/// Earth's angular radius (64–70° from 800–400 km), ≥ 2 300 px for this camera
-/// (f = 1 140 px), over seven times the frame's width; a piece of the disc cut by one
-/// side alone is then at most c²/8R ≈ 6 px deep for a chord c of the whole side
-/// (328 px): under a cell. So a piece of the Earth is cut by two sides or more (a
-/// corner, a band), and a component cut by one side is a target. A camera in a high
-/// orbit, where the Earth's disc fits in the frame, would need 1 (the classifier then
-/// judges every border component, as before session 31).
-pub const EARTH_MIN_SIDES: u8 = 2;
-
-/// A component of stage 2c cut by one side of the window and reaching this many cells
-/// along it may still be a shallow piece of the Earth's disc (the classifier judges
-/// it): a piece cut by one side alone is 1–6 px deep ([`EARTH_MIN_SIDES`]), and at
-/// the least depth that shows (1 px) its chord is 2√(2R · 1 px) ≈ 136 px for the
-/// smallest radius of curvature R ≈ 2 300 px: 16 cells (128 px) with a cell of margin.
-/// (The `paper` world's `paperB/000062.png`, held out: a 2-px sliver of the Earth along
-/// the top, 256 px long, joined a target's component and was boxed with it.)
-pub const EARTH_MIN_CHORD_CELLS: usize = 16;
 
 /// Confidence of a box of stage 2d (a small target over deep space, [`small`]), ‰:
 /// its hit rate (IoU ≥ ½) on family A (seed 7001: realistic 6 of 16, paper 6 of 6,
@@ -814,12 +785,9 @@ impl AutoV2 {
 
     /// Stage 2c ([`smooth`]): when the window is deep space, its departing cells'
     /// strongest component refined as the classifier's winner is (stages 5, 7 and 8),
-    /// with [`DEEP_SPACE_SCORE_PERMILLE`] (cut by one side of the window:
-    /// [`DEEP_SPACE_BORDER_SCORE_PERMILLE`]); `None` (the classifier decides) when the
-    /// window is not deep space, no cell departs, the component touches
-    /// [`EARTH_MIN_SIDES`] sides (or one along [`EARTH_MIN_CHORD_CELLS`]) or the
-    /// refinement finds no boundary (a far target
-    /// within a cell's noise; the shading's own departures).
+    /// with [`DEEP_SPACE_SCORE_PERMILLE`]; `None` (the classifier decides) when the
+    /// window is not deep space, no cell departs or the refinement finds no boundary
+    /// (a far target within a cell's noise; the shading's own departures).
     ///
     /// Kept out of line (it runs once per frame): inlined into `run_in`, stage 2d's
     /// code (off by default) cost the M7 +0.22 M instructions on every embedded frame
@@ -865,27 +833,21 @@ impl AutoV2 {
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
                 .flatten();
         }
-        // A component cut by two or more sides of the window may be the Earth's disc in
-        // a corner (the rest of the frame deep space): the classifier, trained on such
-        // frames, decides. One cut by a single side is a target cut by the frame
-        // ([`EARTH_MIN_SIDES`]), with its own confidence.
-        let sides = w8.sides_touched(plane8);
-        // Its extent along the side it touches, cells (the cell box's: at least its
-        // contact with that side).
-        let along_cells = if w8.x0 == 0 || w8.x_end() >= plane8.0 {
-            w8.y_end() - usize::from(w8.y0)
-        } else {
-            w8.x_end() - usize::from(w8.x0)
-        };
-        if sides >= EARTH_MIN_SIDES || (sides == 1 && along_cells >= EARTH_MIN_CHORD_CELLS) {
+        // A component on the window's border may be the Earth's disc in a corner (the
+        // rest of the frame deep space): the classifier, trained on such frames, decides.
+        if w8.sides_touched(plane8) > 0 {
             return None;
         }
-        let score = if sides == 0 {
-            DEEP_SPACE_SCORE_PERMILLE
-        } else {
-            DEEP_SPACE_BORDER_SCORE_PERMILLE
-        };
-        let d = self.finish(frame, work, win, plane8, lv, (root, w8, next), score, true);
+        let d = self.finish(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            (root, w8, next),
+            DEEP_SPACE_SCORE_PERMILLE,
+            true,
+        );
         // A box one pixel across is a hot pixel (the real camera's signature): no
         // target is imaged on fewer than 2 px across (the `realistic` world's
         // smallest far target: 3 px).
@@ -903,7 +865,7 @@ impl AutoV2 {
                 .flatten();
         }
         work.deep_space = Some(seen);
-        Some(if score < self.min_score_permille {
+        Some(if DEEP_SPACE_SCORE_PERMILLE < self.min_score_permille {
             NO_TARGET
         } else {
             d
@@ -1697,60 +1659,6 @@ mod tests {
         let frame = Frame::reference(&px).unwrap();
         off.detect(&frame, &mut scratch).unwrap();
         assert!(scratch.work().deep_space().is_none());
-    }
-
-    /// Stage 2c at the frame's border: a target cut by one side of a shaded sky is the
-    /// stage's with [`DEEP_SPACE_BORDER_SCORE_PERMILLE`]; a shallow strip along a side as
-    /// long as [`EARTH_MIN_CHORD_CELLS`] and a face cut by two sides (a corner), where
-    /// the Earth's disc may be, are left to the classifier.
-    #[test]
-    fn a_target_cut_by_one_side_is_the_deep_space_stage_s_a_corner_is_not() {
-        let det = AutoV2::default();
-        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
-        let with_face = |xs: core::ops::Range<usize>, ys: core::ops::Range<usize>| {
-            let mut px = shaded_sky(false, true);
-            for (i, v) in px.iter_mut().enumerate() {
-                if xs.contains(&(i % FRAME_WIDTH)) && ys.contains(&(i / FRAME_WIDTH)) {
-                    *v += 60;
-                }
-            }
-            px
-        };
-        // Cut by the left side only.
-        let px = with_face(0..50, 90..140);
-        let frame = Frame::reference(&px).unwrap();
-        let d = det.detect(&frame, &mut scratch).unwrap();
-        assert!(scratch.work().deep_space().is_some(), "{d:?}");
-        assert_eq!(d.score_permille, DEEP_SPACE_BORDER_SCORE_PERMILLE, "{d:?}");
-        let r = d.roi.expect("the target's box");
-        assert!(r.iou(&Roi::new(0, 90, 50, 140)) > 0.9, "{r:?}");
-        // A shallow strip along the top as long as the Earth's shortest chord (a piece of
-        // its disc cut by one side): the classifier judges it; a short one is the stage's.
-        for (xs, stage) in [(40..300, false), (100..160, true)] {
-            let mut px = shaded_sky(false, true);
-            for (i, v) in px.iter_mut().enumerate() {
-                if xs.contains(&(i % FRAME_WIDTH)) && i / FRAME_WIDTH < 12 {
-                    *v += 400;
-                }
-            }
-            let frame = Frame::reference(&px).unwrap();
-            let d = det.detect(&frame, &mut scratch).unwrap();
-            assert_eq!(
-                scratch.work().deep_space().is_some(),
-                stage,
-                "{xs:?}: {d:?}"
-            );
-        }
-        // Cut by the left and top sides: not the stage's box.
-        let px = with_face(0..50, 0..50);
-        let frame = Frame::reference(&px).unwrap();
-        let d = det.detect(&frame, &mut scratch).unwrap();
-        assert!(scratch.work().deep_space().is_none(), "{d:?}");
-        assert!(
-            d.score_permille != DEEP_SPACE_BORDER_SCORE_PERMILLE
-                && d.score_permille != DEEP_SPACE_SCORE_PERMILLE,
-            "{d:?}"
-        );
     }
 
     /// Stage 2d: a 4×4-px target of 6 σ straddling four cells moves each cell's mean
