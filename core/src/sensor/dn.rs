@@ -102,17 +102,12 @@ impl DnMapping {
             f64::MAX,
             "a finite F > f_min_w_m2",
         )?;
-        let span = f_max_w_m2 - f_min_w_m2;
-        if span.is_nan() || span <= 0.0 {
-            return Err(SensorError::OutOfRange {
-                name: "f_max_w_m2",
-                value: f_max_w_m2,
-                expected: "F_max > F_min (a scene of one temperature has no range)",
-            });
-        }
-        let full = full_scale(bits);
-        let gain = full / span;
-        Self::new(gain, -gain * f_min_w_m2, bits)
+        Self::range_map(
+            (f_min_w_m2, f_max_w_m2),
+            bits,
+            "f_max_w_m2",
+            "F_max > F_min (a scene of one temperature has no range)",
+        )
     }
 
     /// Eq. 17 on a camera's measured signal: `lo` ↦ DN 0 and `hi` ↦ 2ⁿ − 1 for any
@@ -126,12 +121,28 @@ impl DnMapping {
     pub fn radiometry_auto_measured(lo: f64, hi: f64, bits: u8) -> Result<Self, SensorError> {
         check_range("lo", lo, f64::MIN, f64::MAX, "a finite signal")?;
         check_range("hi", hi, lo, f64::MAX, "a finite signal > lo")?;
+        Self::range_map(
+            (lo, hi),
+            bits,
+            "hi",
+            "hi > lo (a signal of one level has no range)",
+        )
+    }
+
+    /// `lo` ↦ DN 0 and `hi` ↦ 2ⁿ − 1 (both Eq. 17 maps, their ends checked by the
+    /// caller); an empty span is refused as `hi_name` with `one_level`.
+    fn range_map(
+        (lo, hi): (f64, f64),
+        bits: u8,
+        hi_name: &'static str,
+        one_level: &'static str,
+    ) -> Result<Self, SensorError> {
         let span = hi - lo;
         if span.is_nan() || span <= 0.0 {
             return Err(SensorError::OutOfRange {
-                name: "hi",
+                name: hi_name,
                 value: hi,
-                expected: "hi > lo (a signal of one level has no range)",
+                expected: one_level,
             });
         }
         let gain = full_scale(bits) / span;
