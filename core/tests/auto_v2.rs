@@ -53,6 +53,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
         prior(),
         any::<bool>(),
         any::<bool>(),
+        prop_oneof![Just(3u8), 1u8..=4],
     )
         .prop_map(
             |(
@@ -66,6 +67,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 prior,
                 deep_space,
                 small_target,
+                candidates,
             )| {
                 AutoV2 {
                     prior,
@@ -78,6 +80,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     blob,
                     deep_space,
                     small_target,
+                    candidates,
                 }
             },
         )
@@ -309,7 +312,7 @@ proptest! {
     /// Parameters out of bounds: an error naming the field, never a panic, on any frame.
     #[test]
     fn parameters_out_of_bounds_are_errors(
-        which in 0u8..4,
+        which in 0u8..6,
         seed in any::<u64>(),
     ) {
         let img = frame(seed, 64, 48, 14);
@@ -317,6 +320,8 @@ proptest! {
             0 => AutoV2 { fine_sigma: 0, ..AutoV2::default() },
             1 => AutoV2 { cell_score: 4097, ..AutoV2::default() },
             2 => AutoV2 { min_score_permille: 1001, ..AutoV2::default() },
+            3 => AutoV2 { candidates: 0, ..AutoV2::default() },
+            4 => AutoV2 { candidates: 5, ..AutoV2::default() },
             _ => AutoV2 { saturated_erode_px: 9, ..AutoV2::default() },
         };
         let got = bad.detect(&img.frame(), &mut Box::new(AutoV2Scratch::new()));

@@ -15,7 +15,7 @@
 //! 8 × 6 grid of levels interpolated bilinearly over the frame (kinks and steps between
 //! grid points depart from any polynomial), the rest a small periodic pattern (their
 //! top 6 bits) on top; clipped to the bit depth. Byte 8's bit 5 turns stage 2c off,
-//! bit 4 stage 2d on.
+//! bit 4 stage 2d on. Byte 2's bits 4–5 are the components stage 4b rates − 1.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -86,6 +86,7 @@ fuzz_target!(|data: &[u8]| {
             1 => BlobRule::Always,
             _ => BlobRule::Compete,
         },
+        candidates: 1 + ((data[2] >> 4) & 3),
     };
     let dn: Vec<u16> = data[dn_from..]
         .chunks_exact(2)
