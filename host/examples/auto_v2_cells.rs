@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p tirroi-host --example auto_v2_cells -- features DIR OUT.csv`
 //! writes, for every frame of a dataset rendered with `--masks`, one line per 8×8 cell:
-//! `frame,cx,cy,coverage,f0..f26` (coverage: the mean of the cell's mask values,
+//! `frame,cx,cy,coverage,f0..f32` (coverage: the mean of the cell's mask values,
 //! 0–255, i.e. the share of the cell covered by the target × 255; for a dataset without
 //! `masks/`, e.g. `tirroi fixtures --count N --seed S`, the truth box stands for the mask).
 //!
@@ -22,7 +22,9 @@
 //! trim_permille; `k_sigma` 0 turns the stage off) and the saturated blob's rule
 //! (`AutoV2::blob`: `off`, `compete` (the default) or `always`, the blob model's
 //! training data; run the confidence model's `predict-all` with `off`: its winner
-//! statistics are the classifier's). Every line ends with
+//! statistics are the classifier's) and the components stage 4b rates
+//! (`AutoV2::candidates`, 1..=4; the confidence model's training data is the strongest
+//! alone: 1). Every line ends with
 //! the frame's largest saturated blob (`learned::blob::BlobStats`: saturated pixels,
 //! solidity ‰, ring depth ‰, others ‰, sides, its confidence ‰; empty without one),
 //! the blob model's training data (`scripts/train-auto.py --blob`).
@@ -88,6 +90,11 @@ fn main() {
             std::process::exit(2)
         }
     };
+    // Optional: the components stage 4b rates (default: `AutoV2::default()`'s).
+    let candidates = args
+        .get(12)
+        .map(|v| v.parse::<u8>().expect("candidates: 1..=4"))
+        .unwrap_or(AutoV2::default().candidates);
     let list = common::frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -143,6 +150,7 @@ fn main() {
                     saturated_erode_px: erode,
                     body,
                     blob,
+                    candidates,
                     ..AutoV2::default()
                 };
                 let mut d = gate_off.detect(&frame, &mut scratch).expect("detect");

@@ -656,7 +656,12 @@ fn prepare_cells<C: FrameCapacity>(
         work.cell_sums.as_mut(),
         work.col_sat.as_mut(),
     );
-    let lv = levels(&work.mean_dn.as_ref()[..n], sigma, frame.max_dn());
+    let lv = levels(
+        &work.mean_dn.as_ref()[..n],
+        &work.step_code.as_ref()[..n],
+        sigma,
+        frame.max_dn(),
+    );
     (plane, lv)
 }
 
@@ -1429,7 +1434,7 @@ mod tests {
         let vals: std::vec::Vec<u16> = px.iter().step_by(61).copied().take(1271).collect();
         let mut sorted = vals.clone();
         sorted.sort_unstable();
-        let lv = features::levels(&vals, 3, 16383);
+        let lv = features::levels(&vals, &[], 3, 16383);
         let n = vals.len() - 1;
         assert_eq!(lv.p2, sorted[n * 2 / 100]);
         assert_eq!(lv.p50, sorted[n * 50 / 100]);
@@ -1475,6 +1480,15 @@ mod tests {
             }
             assert!(f.iter().all(|v| v.abs() <= 1 << 16));
             assert_eq!(f.len(), FEATURES);
+        }
+        // Feature 32: the cell's step code less the frame's 90th percentile of them
+        // (a sort of every cell's feature 3).
+        let mut steps: std::vec::Vec<i32> = got.iter().map(|(_, _, f)| f[3]).collect();
+        steps.sort_unstable();
+        let rank = steps[(steps.len() - 1) * features::STEP_RANK_PERCENT / 100];
+        assert!(rank > steps[0], "the frame has steps of several sizes");
+        for &(cx, cy, f) in &got {
+            assert_eq!(f[FEATURES - 1], f[3] - rank, "cell ({cx}, {cy})");
         }
     }
 
@@ -1873,6 +1887,7 @@ mod tests {
             sigma: 8,
             sd_shift: 0,
             max_dn: 16383,
+            step_rank_code: 0,
         };
         let cross = |x: usize, y: usize| (14..17).contains(&y) || (19..22).contains(&x);
         let block = |x: usize, y: usize, x0: usize, y0: usize, side: usize| {
