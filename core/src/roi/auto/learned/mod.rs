@@ -109,13 +109,14 @@ pub struct AutoV2 {
     /// `docs/detectors.md` § Session 30).
     pub small_target: bool,
     /// Stage 4b: how many of the classifier's strongest components (by summed cell
-    /// energy) the confidence model rates, the most confident winning; 1 (or 0) keeps
-    /// the strongest (sessions 26–31); 1..=[`MAX_CANDIDATES`]. Default 3, chosen on
-    /// family A (seed 7001; summed gated mean IoU of realistic, paper and fixtures,
-    /// ½ convention: 1 → 2.036, 2 → 2.057, 3 and 4 → 2.066, the smallest on the
-    /// plateau): the strongest component is often
-    /// a cloud deck, the limb or the frame's edge, and the target a weaker component
-    /// the confidence model rates higher (`docs/detectors.md` § Session 32).
+    /// energy) the confidence model rates, the most confident winning; 1 keeps the
+    /// strongest (sessions 26–31); 1..=[`MAX_CANDIDATES`], else
+    /// [`DetectError::InvalidParameter`]. Default 3, chosen on family A (seed 7001;
+    /// summed gated mean IoU of realistic, paper and fixtures, ½ convention: 1 → 2.036,
+    /// 2 → 2.057, 3 and 4 → 2.066, the smallest on the plateau; with the forest
+    /// retrained for feature 32: 3 → 2.078, 4 → 2.082, kept): the strongest component
+    /// is often a cloud deck, the limb or the frame's edge, and the target a weaker
+    /// component the confidence model rates higher (`docs/detectors.md` § Session 32).
     pub candidates: u8,
 }
 
