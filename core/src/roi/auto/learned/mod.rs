@@ -823,12 +823,11 @@ impl AutoV2 {
                 .unwrap_or(NO_TARGET);
         };
         // Stage 4b: the strongest components rated by the confidence model.
-        let Some((root, w8, winner, _)) = self.most_confident(work, plane8, lv, n8, root, next)
-        else {
+        let Some((root, w8, winner)) = self.most_confident(work, plane8, lv, n8, root, next) else {
             return NO_TARGET;
         };
         work.winner = Some(winner);
-        let score_permille = work.winner.map_or(0, |w| w.score_permille());
+        let score_permille = winner.score_permille();
         if let Some(d) = self.blob_over(frame, work, win, plane8, lv, blob_score, score_permille) {
             return d;
         }
@@ -849,8 +848,8 @@ impl AutoV2 {
 
     /// Stage 4b: of the [`AutoV2::candidates`] strongest components of `labels8`
     /// (`strongest` first, labels `1..next`), the one the confidence model rates
-    /// highest (the stronger on a tie), with its cell statistics, its [`Winner`] and
-    /// its confidence ‰; `None` without a component. Every candidate is rated whatever
+    /// highest (the stronger on a tie), with its cell statistics and its [`Winner`];
+    /// `None` without a component. Every candidate is rated whatever
     /// the gate, so the answer above the gate does not depend on it (a box at one
     /// threshold is the box at every lower one; stopping once one passes the gate
     /// saved the M7 0.28 M instructions per frame but broke that).
@@ -862,7 +861,7 @@ impl AutoV2 {
         n8: usize,
         strongest: u8,
         next: usize,
-    ) -> Option<(u8, CellStats, Winner, u16)> {
+    ) -> Option<(u8, CellStats, Winner)> {
         let (ranked, components) = strongest_roots(&work.comps, next, strongest);
         let top_energy = ranked.first().map_or(0, |&(_, e)| e);
         let mut best: Option<(u8, CellStats, Winner, u16)> = None;
@@ -887,7 +886,7 @@ impl AutoV2 {
                 best = Some((l, stats, w, score));
             }
         }
-        best
+        best.map(|(l, stats, w, _)| (l, stats, w))
     }
 
     /// Stage 2c ([`smooth`]): when the window is deep space, its departing cells'
@@ -1944,11 +1943,10 @@ mod tests {
                 min_score_permille: gate,
                 ..AutoV2::default()
             };
-            let (l, _, w, score) = det
+            let (l, _, w) = det
                 .most_confident(work, (pw, ph), lv, n8, strongest, next)
                 .unwrap();
-            assert_eq!(w.score_permille(), score);
-            (l, score)
+            (l, w.score_permille())
         };
         assert_eq!(pick(1, 1000, &mut work), scores[0]);
         assert_eq!(pick(3, 1000, &mut work), best);
