@@ -138,10 +138,14 @@ const LABEL_INSTR_PER_CELL: u32 = 64;
 /// Refinement: per cell of the region grown by a cell (gate: two dilation passes).
 const GATE_INSTR_PER_CELL: u32 = 24;
 /// Refinement: per pixel of the region: the saturation count (one pass over gated
-/// cells) and the outline's worst case (every row scanned from both sides, and down
-/// every row for vertical boundaries, each candidate pixel tested). A whole-frame
-/// region of edges (`holes-3`) measured 33.5.
-const REFINE_INSTR_PER_PX: u32 = 40;
+/// cells) and the outline's worst case: every row scanned to its end without a
+/// boundary (each pixel tested once from the left or the right, a row per cell band
+/// twice) and every row tested for vertical boundaries, with the row set-ups. A small
+/// region does that when nothing but its first boundary lies in it: `plate-holes-2`'s
+/// corner window (34 × 34 px) measured 91.5 (session 33; 40, from `holes-3`'s
+/// whole-frame region at 33.5, undercharged it by 13 %); whole-frame regions, whose
+/// scans stop at the outermost boundaries, 13–34. The measured worst × 1.2.
+const REFINE_INSTR_PER_PX: u32 = 110;
 
 /// The charges of one call: what is left, what was charged.
 #[derive(Debug, Clone, Copy)]
@@ -273,8 +277,8 @@ const fn refinement_charge(cells: usize, px: usize) -> u64 {
 /// The largest charge of an `auto` call on a `width × height` frame (pixels; the
 /// capacity's at most): a budget of at least this never stops the call. With
 /// `tracking`, two passes (the window around the prior, then the full frame); the
-/// refinement as if its region were the whole frame. 7 180 464 instructions at
-/// 328 × 248 without a prior, 14 358 928 with one.
+/// refinement as if its region were the whole frame. 12 874 544 instructions at
+/// 328 × 248 without a prior, 25 747 088 with one.
 pub const fn largest_charge(width: usize, height: usize, tracking: bool) -> u32 {
     let (pw, ph) = (width.div_ceil(BLOCK), height.div_ceil(BLOCK));
     let cells = pw * ph;
