@@ -10,7 +10,7 @@
 //! | `stripes-v-P`, `stripes-h-P`, P = 1, 2 | 4 | all-edge frames: every column (row) an edge |
 //! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
 //! | `framed-holes-S`, S = 2, 3 | 2 | `holes-S` inside an 8-px margin at a quarter of the range: a saturated blob over nearly the whole frame that passes `auto-v2`'s gate, so its refinement, body stage and shape statistics run over the whole frame (session 32: with the retrained forest `holes-3` no longer does) |
-//! | `plate-holes-S`, S = 2, 3 | 2 | `holes-S` on a plate at half the range inside the same margin: `auto`'s tracking window in a corner takes a small region whose every row is scanned to its end without a boundary (session 33: it counted 2.3× the refinement's per-pixel charge of the time) |
+//! | `plate-holes-S`, S = 2, 3 | 2 | `holes-S` on a plate at half the range, the margin on the top and left only: `auto`'s refinement scans every row and column of its region to the end without a boundary, in the whole frame and in the tracking window at the top-left corner (session 33: that small region counted 2.3× the refinement's per-pixel charge of the time) |
 //! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
 //! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
 //! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: a nearly flat score over the bins between, but not flat enough (Otsu refines 2 bins) |
@@ -54,7 +54,8 @@ pub enum Case {
     /// [`Case::Holes`] inside a [`FRAME_MARGIN_PX`] margin at a quarter of the range.
     FramedHoles(usize),
     /// [`Case::FramedHoles`] with the lattice's plate at half the range instead of
-    /// saturated.
+    /// saturated, and the margin on the top and left sides only: no boundary ends a
+    /// row's scan from the right or a column's from the bottom.
     PlateHoles(usize),
     /// Uniform noise over 0..=MAX_DN from seed `N`.
     Noise(u64),
@@ -278,13 +279,13 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
             Case::Dots(s) => on(x % s == 0 && y % s == 0),
             Case::Holes(s) => on(!(x % s == 0 && y % s == 0)),
             Case::FramedHoles(s) | Case::PlateHoles(s) => {
-                let inside = (FRAME_MARGIN_PX..FRAME_WIDTH - FRAME_MARGIN_PX).contains(&x)
-                    && (FRAME_MARGIN_PX..FRAME_HEIGHT - FRAME_MARGIN_PX).contains(&y);
-                let plate = if matches!(case, Case::PlateHoles(_)) {
-                    MAX_DN / 2
+                let (plate, right_px, bottom_px) = if matches!(case, Case::PlateHoles(_)) {
+                    (MAX_DN / 2, 0, 0)
                 } else {
-                    MAX_DN
+                    (MAX_DN, FRAME_MARGIN_PX, FRAME_MARGIN_PX)
                 };
+                let inside = (FRAME_MARGIN_PX..FRAME_WIDTH - right_px).contains(&x)
+                    && (FRAME_MARGIN_PX..FRAME_HEIGHT - bottom_px).contains(&y);
                 match (inside, x % s == 0 && y % s == 0) {
                     (false, _) => MAX_DN / 4,
                     (true, true) => 0,

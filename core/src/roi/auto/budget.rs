@@ -143,8 +143,9 @@ const GATE_INSTR_PER_CELL: u32 = 24;
 /// twice) and every row tested for vertical boundaries, with the row set-ups. A small
 /// region does that when nothing but its first boundary lies in it: `plate-holes-2`'s
 /// corner window (34 × 34 px) measured 91.5 (session 33; 40, from `holes-3`'s
-/// whole-frame region at 33.5, undercharged it by 13 %); whole-frame regions, whose
-/// scans stop at the outermost boundaries, 13–34. The measured worst × 1.2.
+/// whole-frame region at 33.5, undercharged it by 13 %), its whole frame 65 (the
+/// row set-ups weigh less in long rows); whole-frame regions whose scans stop at
+/// boundaries 13–34. The measured worst × 1.2.
 const REFINE_INSTR_PER_PX: u32 = 110;
 
 /// The charges of one call: what is left, what was charged.
