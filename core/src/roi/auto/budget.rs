@@ -142,11 +142,12 @@ const GATE_INSTR_PER_CELL: u32 = 24;
 /// boundary (each pixel tested once from the left or the right, a row per cell band
 /// twice) and every row tested for vertical boundaries, with the row set-ups. A small
 /// region does that when nothing but its first boundary lies in it: `plate-holes-2`'s
-/// corner window (34 × 34 px) measured 91.5 (session 33; 40, from `holes-3`'s
-/// whole-frame region at 33.5, undercharged it by 13 %), its whole frame 65 (the
-/// row set-ups weigh less in long rows); whole-frame regions whose scans stop at
-/// boundaries 13–34. The measured worst × 1.2.
-const REFINE_INSTR_PER_PX: u32 = 110;
+/// corner window (34 × 34 px) measured 71.6 (session 33, after the outline's scans
+/// were made to test each pixel once and on raw steps first; before, 91.5, which 40,
+/// from `holes-3`'s whole-frame region at 33.5, undercharged by 13 %), its whole frame
+/// 41.7 (the row set-ups weigh less in long rows); whole-frame regions whose scans stop
+/// at boundaries 13–34. The measured worst × 1.2.
+const REFINE_INSTR_PER_PX: u32 = 86;
 
 /// The charges of one call: what is left, what was charged.
 #[derive(Debug, Clone, Copy)]
@@ -278,8 +279,8 @@ const fn refinement_charge(cells: usize, px: usize) -> u64 {
 /// The largest charge of an `auto` call on a `width × height` frame (pixels; the
 /// capacity's at most): a budget of at least this never stops the call. With
 /// `tracking`, two passes (the window around the prior, then the full frame); the
-/// refinement as if its region were the whole frame. 12 874 544 instructions at
-/// 328 × 248 without a prior, 25 747 088 with one.
+/// refinement as if its region were the whole frame. 10 922 288 instructions at
+/// 328 × 248 without a prior, 21 842 576 with one.
 pub const fn largest_charge(width: usize, height: usize, tracking: bool) -> u32 {
     let (pw, ph) = (width.div_ceil(BLOCK), height.div_ceil(BLOCK));
     let cells = pw * ph;

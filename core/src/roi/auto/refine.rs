@@ -365,10 +365,13 @@ pub(super) fn outline(
         )
     });
     let mut found = Boundaries::NONE;
-    // The cheap test of a pixel pair (clamped) before the boundary tests: a step of
-    // τ, or (clean deep space) 0 DN beside a pixel above it.
-    let candidate =
-        |l: u16, r: u16| l.abs_diff(r) >= tau || (clean && l.min(r) == 0 && l.max(r) > 0);
+    // The cheap test of a pixel pair before the boundary tests: a step of τ between
+    // the clamped values, or (clean deep space) 0 DN beside a pixel above it. Raw
+    // values first: clamping never widens a step, and most pairs fail on it alone.
+    let candidate = |l: u16, r: u16| {
+        (l.abs_diff(r) >= tau && clamp(l).abs_diff(clamp(r)) >= tau)
+            || (clean && l.min(r) == 0 && l.max(r) > 0)
+    };
     // One row per cell band first (cheap bounds for the rest), then every row.
     let sparse = (ry0 + BLOCK / 2..ry1).step_by(BLOCK);
     for y in sparse.chain(ry0..ry1) {
@@ -380,7 +383,7 @@ pub(super) fn outline(
             let triples = row.get(xa.wrapping_sub(1)..xb + 1).filter(|_| xa < xb)?;
             let mut hits = (xa..xb)
                 .zip(triples.windows(3))
-                .filter(|(_, t)| candidate(clamp(t[0]), clamp(t[2])));
+                .filter(|(_, t)| candidate(t[0], t[2]));
             if backwards {
                 hits.rev().find_map(|(x, _)| h_boundary(row, x, y))
             } else {
@@ -411,16 +414,14 @@ pub(super) fn outline(
         let (Some(a), Some(d)) = (a.get(rx0..rx1), d.get(rx0..rx1)) else {
             return false;
         };
-        let largest = a
-            .iter()
-            .zip(d)
-            .fold(0, |m, (&u, &w)| m.max(clamp(u).abs_diff(clamp(w))));
+        // (Raw steps: clamping never widens one, so a row below τ raw is below τ.)
+        let largest = a.iter().zip(d).fold(0, |m, (&u, &w)| m.max(u.abs_diff(w)));
         if largest < tau && !(clean && a.iter().zip(d).any(|(&u, &w)| (u == 0) != (w == 0))) {
             return false;
         }
         let mut hit = false;
         for (x, (&u, &w)) in (rx0..rx1).zip(a.iter().zip(d)) {
-            if !candidate(clamp(u), clamp(w)) {
+            if !candidate(u, w) {
                 continue;
             }
             if let Some(b) = v_boundary(x, y) {
