@@ -158,7 +158,9 @@ CONF_FEATURES = ["log_cells", "log_box", "fill_permille", "sides", "mean_code16"
                  # its cells are, and terms per size class (small: 1-2 cells, far targets).
                  "log_edge_sides", "log_reach", "spans", "spread_code", "spread_minus_contrast",
                  "step_mean_code", "interior_permille", "interior_step_code", "straight_permille",
-                 "small", "small_clutter", "small_mean_code16", "touch_mean_code16"]
+                 "small", "small_clutter", "small_mean_code16", "touch_mean_code16",
+                 # Session 33 (`shape::roughness_permille`): rough pixels inside, per mille.
+                 "rough_permille"]
 CONF_ONE = 4096
 # Features the model uses (the others get weight 0): statistics of the winner itself
 # that do not count the background (issue 16: on real GOES texture the forest finds ~5
@@ -175,7 +177,12 @@ CONF_ONE = 4096
 # summed gated mean IoU of the three sets, 1/2 convention): the 4 above 1.950 (gate
 # 0.60), + the interior cells' step code 1.986, + the small-winner term 1.989 (gate
 # 0.55); nothing else adds 0.002. See docs/detectors.md § auto-v2.
-CONF_KEEP = ["log_cells", "sides", "mean_code16", "clutter_code", "interior_step_code", "small"]
+# Session 33: the roughness added, trained with 300 more realistic frames without a
+# target (famAE, scripts/training/realistic-no-target.toml): family A's summed gated IoU
+# 2.078 = 2.078 with false alarms 15 -> 11 of 440 (the famAE set alone, without the
+# roughness: 2.046, 9; the roughness alone: 2.100, 17). docs/detectors.md § Session 33.
+CONF_KEEP = ["log_cells", "sides", "mean_code16", "clutter_code", "interior_step_code", "small",
+             "rough_permille"]
 
 
 def log_code(v):
@@ -196,7 +203,8 @@ def conf_features(r):
             int(r["spread_code"]), int(r["spread_code"]) - int(r["contrast_code"]),
             int(r["step_mean_code"]), int(r["interior_cells"]) * 1000 // max(c, 1),
             int(r["interior_step_code"]), straight_permille(w, h, int(r["perimeter"])),
-            small, small * clutter, small * mean16, int(sides > 0) * mean16]
+            small, small * clutter, small * mean16, int(sides > 0) * mean16,
+            int(r.get("rough") or 0)]
 
 
 # A winner of at most this many cells is "small" (a far target, 3-12 px: one or two

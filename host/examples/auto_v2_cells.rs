@@ -182,7 +182,7 @@ fn main() {
                     Some(w) => {
                         let _ = write!(
                             s,
-                            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                             w.cells,
                             w.box_w_cells,
                             w.box_h_cells,
@@ -200,10 +200,11 @@ fn main() {
                             w.shape.spread_code,
                             w.shape.step_mean_code,
                             w.shape.interior_cells,
-                            w.shape.interior_step_code
+                            w.shape.interior_step_code,
+                            w.rough_permille
                         );
                     }
-                    None => s.push_str(",,,,,,,,,,,,,,,,,,"),
+                    None => s.push_str(",,,,,,,,,,,,,,,,,,,"),
                 }
                 match scratch.work().blob() {
                     Some(b) => {
@@ -233,7 +234,7 @@ fn main() {
     } else {
         "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up,\
              perimeter,contrast_code,clutter_code,edge_sides,reach,spans,spread_code,step_mean_code,\
-             interior_cells,interior_step_code,blob_px,blob_solid,blob_ring,blob_other,blob_sides,blob_score"
+             interior_cells,interior_step_code,rough,blob_px,blob_solid,blob_ring,blob_other,blob_sides,blob_score"
             .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");

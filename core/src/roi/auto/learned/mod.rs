@@ -241,10 +241,13 @@ pub struct Winner {
     pub runner_up_permille: u16,
     /// Its outline and border contrast ([`shape::winner_shape`]).
     pub shape: shape::WinnerShape,
+    /// Rough pixels inside it, ‰ ([`shape::roughness_permille`]): cloud texture vs a
+    /// target's flat faces.
+    pub rough_permille: u16,
 }
 
 /// Number of the confidence model's features ([`Winner::confidence_features`]).
-pub const CONFIDENCE_FEATURES: usize = 24;
+pub const CONFIDENCE_FEATURES: usize = 25;
 
 /// A winner of at most this many 8×8 cells is "small" for the confidence's size-class
 /// terms, cells: a far target of 3–12 px lies in one or two cells, and a linear weight
@@ -265,7 +268,8 @@ impl Winner {
     /// mean step code, the straightness ‰ (its cell box's outline over its own, capped
     /// at 1000); and terms per size class: small (at most [`SMALL_WINNER_CELLS`]: 1,
     /// else 0), small × the clutter contrast, small × the mean code × 16, and "touches
-    /// the frame's edge" × the mean code × 16. Which of them the model uses is
+    /// the frame's edge" × the mean code × 16; last, its roughness ‰
+    /// ([`shape::roughness_permille`]). Which of them the model uses is
     /// `confidence_weights.rs`' choice (weight 0: unused).
     pub fn confidence_features(&self) -> [i32; CONFIDENCE_FEATURES] {
         let cells = u32::from(self.cells).max(1);
@@ -303,6 +307,7 @@ impl Winner {
             small * clutter,
             small * mean16,
             i32::from(self.sides > 0) * mean16,
+            i32::from(self.rough_permille),
         ]
     }
 
@@ -516,6 +521,8 @@ fn strongest_roots(
 /// marks its cells in `dilated4` (free until stage 5's gate).
 #[allow(clippy::too_many_arguments)]
 fn rate_component<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    win: Window,
     work: &mut AutoV2Work<C>,
     plane8: (usize, usize),
     lv: FrameLevels,
@@ -562,7 +569,16 @@ fn rate_component<C: FrameCapacity>(
         ),
         lv.sigma,
     );
+    let rough_permille = shape::roughness_permille(
+        frame,
+        (win.x0, win.y0),
+        work.dilated4.as_ref().get(..n8).unwrap_or_default(),
+        plane8.0,
+        usize::from(w8.area),
+        lv.sigma,
+    );
     Winner {
+        rough_permille,
         cells: w8.area,
         box_w_cells: w8.x_last - w8.x0 + 1,
         box_h_cells: w8.y_last - w8.y0 + 1,
@@ -823,7 +839,9 @@ impl AutoV2 {
                 .unwrap_or(NO_TARGET);
         };
         // Stage 4b: the strongest components rated by the confidence model.
-        let Some((root, w8, winner)) = self.most_confident(work, plane8, lv, n8, root, next) else {
+        let Some((root, w8, winner)) =
+            self.most_confident(frame, win, work, plane8, lv, n8, root, next)
+        else {
             return NO_TARGET;
         };
         work.winner = Some(winner);
@@ -853,8 +871,11 @@ impl AutoV2 {
     /// the gate, so the answer above the gate does not depend on it (a box at one
     /// threshold is the box at every lower one; stopping once one passes the gate
     /// saved the M7 0.28 M instructions per frame but broke that).
+    #[allow(clippy::too_many_arguments)]
     fn most_confident<C: FrameCapacity>(
         &self,
+        frame: &Frame<'_>,
+        win: Window,
         work: &mut AutoV2Work<C>,
         plane8: (usize, usize),
         lv: FrameLevels,
@@ -880,7 +901,9 @@ impl AutoV2 {
             } else {
                 top_energy
             };
-            let w = rate_component(work, plane8, lv, n8, l, stats, components, runner_up);
+            let w = rate_component(
+                frame, win, work, plane8, lv, n8, l, stats, components, runner_up,
+            );
             let score = w.score_permille();
             if best.is_none_or(|(_, _, _, b)| score > b) {
                 best = Some((l, stats, w, score));
@@ -1889,6 +1912,10 @@ mod tests {
             max_dn: 16383,
             step_rank_code: 0,
         };
+        // A flat frame under the planes: every component's roughness is 0.
+        let pixels = std::vec![1000u16; pw * 8 * ph * 8];
+        let flat = Frame::new(&pixels, pw * 8, ph * 8, 14).unwrap();
+        let win = Window::full(&flat);
         let cross = |x: usize, y: usize| (14..17).contains(&y) || (19..22).contains(&x);
         let block = |x: usize, y: usize, x0: usize, y0: usize, side: usize| {
             (x0..x0 + side).contains(&x) && (y0..y0 + side).contains(&y)
@@ -1925,8 +1952,18 @@ mod tests {
                 } else {
                     ranked[0].1
                 };
-                let w =
-                    rate_component(&mut work, (pw, ph), lv, n8, l, stats, components, runner_up);
+                let w = rate_component(
+                    &flat,
+                    win,
+                    &mut work,
+                    (pw, ph),
+                    lv,
+                    n8,
+                    l,
+                    stats,
+                    components,
+                    runner_up,
+                );
                 (l, w.score_permille())
             })
             .collect();
@@ -1944,7 +1981,7 @@ mod tests {
                 ..AutoV2::default()
             };
             let (l, _, w) = det
-                .most_confident(work, (pw, ph), lv, n8, strongest, next)
+                .most_confident(&flat, win, work, (pw, ph), lv, n8, strongest, next)
                 .unwrap();
             (l, w.score_permille())
         };
@@ -2104,6 +2141,7 @@ mod tests {
                 code_max: 20,
                 components: comps,
                 runner_up_permille: runner,
+                rough_permille: 37 * u16::from(sides),
                 shape: shape::WinnerShape {
                     perimeter_cells: 4 * u16::from(w),
                     contrast_code: 40,
@@ -2123,6 +2161,7 @@ mod tests {
                     .min(1000.0)
             );
             assert_eq!((f[9], f[10]), (40, 20));
+            assert_eq!(f[24], 37 * i32::from(sides));
             let z: f64 = f
                 .iter()
                 .zip(confidence_weights::WEIGHTS)

@@ -9,7 +9,9 @@
 //! (on real GOES texture the forest finds about 5 components per frame, on our renders
 //! one).
 
+use super::cells::CELL_PX;
 use super::features::log_code;
+use crate::frame::Frame;
 
 /// Width of the ring of background cells around the winner's cell box, cells: one cell
 /// (8 px) is the nearest background whose level the target's border must stand out
@@ -153,6 +155,74 @@ pub fn winner_shape(
         interior_cells: to_u16(interior_n),
         interior_step_code: to_u16(interior_step.checked_div(interior_n).unwrap_or(0)),
     }
+}
+
+/// A second difference along a row above this many pixel σ is "rough": the second
+/// difference of pure noise has a standard deviation of √6 σ ≈ 2.45 σ, so 8 σ is
+/// 3.3 of those (about 0.1 % of noise pixels); cloud texture at the pixel scale and a
+/// boundary's few pixels exceed it, a spacecraft face's interior does not (session 33:
+/// median over the box's cells, hits 9 %, false alarms 41 % of their pixels).
+pub const ROUGH_SIGMAS: u32 = 8;
+
+/// At most this many of the component's cells are read for its roughness (evenly
+/// spaced in raster order): 16 cells × 64 pixels bound the work per rated component
+/// (stage 4b rates up to `MAX_CANDIDATES`), whatever its size.
+pub const ROUGH_MAX_CELLS: usize = 16;
+
+/// The component's roughness, ‰: the share of rough pixels ([`ROUGH_SIGMAS`]) among the
+/// pixels of at most [`ROUGH_MAX_CELLS`] of its 8×8 cells, taken evenly over the
+/// `members` cells marked non-zero in `member` (a plane of `plane.0` cells per row over
+/// the window `(x0, y0)` of `frame`, pixels). Second differences along rows, each pixel
+/// clamped to the frame's top DN; the frame's first and last columns are skipped. The
+/// Earth's limb piece or a cloud deck is rough inside, a target's faces are flat (its
+/// outline's pixels count too, a few per row of a cell). 0 without a cell read.
+///
+/// Kept out of line: inlined (through `rate_component` into `run_in`) it cost the M7
+/// +0.37 M instructions on every embedded frame (`scripts/flight.sh`: `run_in`'s hot
+/// loops spill more; deep space 11.60 → 11.98 M), out of line +0.01–0.03 M (its own
+/// work: at most 3 candidates × 16 cells × 64 pixels).
+#[inline(never)]
+pub fn roughness_permille(
+    frame: &Frame<'_>,
+    (x0, y0): (usize, usize),
+    member: &[u8],
+    plane_w: usize,
+    members: usize,
+    sigma: u32,
+) -> u16 {
+    let stride = members.div_ceil(ROUGH_MAX_CELLS).max(1);
+    let top = frame.max_dn();
+    let thr = i32::try_from(sigma.saturating_mul(ROUGH_SIGMAS)).unwrap_or(i32::MAX);
+    let (mut rough, mut px) = (0u32, 0u32);
+    let mut seen = 0usize;
+    for (i, _) in member.iter().enumerate().filter(|&(_, &m)| m != 0) {
+        seen += 1;
+        if (seen - 1) % stride != 0 {
+            continue;
+        }
+        let (cx, cy) = (i % plane_w.max(1), i / plane_w.max(1));
+        let xa = (x0 + cx * CELL_PX).max(1);
+        let xb = (x0 + cx * CELL_PX + CELL_PX).min(frame.width().saturating_sub(1));
+        for y in y0 + cy * CELL_PX..(y0 + cy * CELL_PX + CELL_PX).min(frame.height()) {
+            let Some(row) = frame.row(y).and_then(|r| r.get(xa - 1..xb + 1)) else {
+                continue;
+            };
+            // The triples (x − 1, x, x + 1) as three zipped slices: no bounds checks.
+            let (Some(mid), Some(right)) = (row.get(1..), row.get(2..)) else {
+                continue;
+            };
+            for ((&a, &b), &c) in row.iter().zip(mid).zip(right) {
+                let (a, b, c) = (
+                    i32::from(a.min(top)),
+                    i32::from(b.min(top)),
+                    i32::from(c.min(top)),
+                );
+                rough += u32::from((a - 2 * b + c).abs() > thr);
+            }
+            px += right.len() as u32;
+        }
+    }
+    (u64::from(rough) * 1000 / u64::from(px.max(1))) as u16
 }
 
 #[cfg(test)]
@@ -375,5 +445,70 @@ mod tests {
         // Bottom row (10 sides), the two rows' left and right ends (4): 14.
         assert_eq!((b.edge_sides, b.reach_cells, b.spans), (14, 1, 1));
         assert_eq!(b.interior_cells, 0);
+    }
+    /// Brute force on random frames: the cells read are every `stride`-th member in
+    /// raster order (at most [`ROUGH_MAX_CELLS`]), each pixel with both row neighbours
+    /// in the frame counts, rough when |v(x−1) − 2v(x) + v(x+1)| > 8σ after clamping;
+    /// a window offset and cells cut by the frame's edge included.
+    #[test]
+    fn roughness_equals_brute_force() {
+        use crate::sensor::rng::Xoshiro128pp;
+        let mut rng = Xoshiro128pp::seed_from_u64(33);
+        for round in 0..200 {
+            let (w, h) = (
+                20 + (rng.next_u32() % 60) as usize,
+                20 + (rng.next_u32() % 50) as usize,
+            );
+            let top = 4095u16;
+            let scale = [0u32, 30, 300, 5000][round % 4];
+            let pixels: std::vec::Vec<u16> = (0..w * h)
+                .map(|_| {
+                    let v = (1000 + rng.next_u32() % (scale + 1)) as u16;
+                    if rng.next_u32() % 50 == 0 { 5000 } else { v }
+                })
+                .collect();
+            let frame = Frame::new(&pixels, w, h, 12).unwrap();
+            let (x0, y0) = ((rng.next_u32() % 5) as usize, (rng.next_u32() % 5) as usize);
+            let (pw, ph) = ((w - x0).div_ceil(8), (h - y0).div_ceil(8));
+            let member: std::vec::Vec<u8> = (0..pw * ph)
+                .map(|_| u8::from(rng.next_u32() % 3 == 0))
+                .collect();
+            let members = member.iter().filter(|&&m| m != 0).count();
+            let sigma = 1 + rng.next_u32() % 40;
+            let got = roughness_permille(&frame, (x0, y0), &member, pw, members, sigma);
+            let stride = members.div_ceil(ROUGH_MAX_CELLS).max(1);
+            let (mut rough, mut px) = (0u64, 0u64);
+            let read: std::vec::Vec<usize> = (0..pw * ph)
+                .filter(|&i| member[i] != 0)
+                .step_by(stride)
+                .collect();
+            assert!(read.len() <= ROUGH_MAX_CELLS);
+            let at = |x: usize, y: usize| i64::from(pixels[y * w + x].min(top));
+            for i in read {
+                let (cx, cy) = (i % pw, i / pw);
+                for y in y0 + cy * 8..(y0 + cy * 8 + 8).min(h) {
+                    for x in x0 + cx * 8..(x0 + cx * 8 + 8).min(w) {
+                        if x == 0 || x + 1 >= w {
+                            continue;
+                        }
+                        let d2 = at(x - 1, y) - 2 * at(x, y) + at(x + 1, y);
+                        rough += u64::from(d2.abs() > i64::from(8 * sigma));
+                        px += 1;
+                    }
+                }
+            }
+            let want = rough * 1000 / px.max(1);
+            assert_eq!(u64::from(got), want, "{w}x{h} at {x0},{y0}, σ {sigma}");
+        }
+        // Flat faces are smooth, noise at σ is almost never rough, a checkerboard is.
+        let flat = std::vec![700u16; 64 * 64];
+        let f = Frame::new(&flat, 64, 64, 12).unwrap();
+        let all = std::vec![1u8; 64];
+        assert_eq!(roughness_permille(&f, (0, 0), &all, 8, 64, 2), 0);
+        let board: std::vec::Vec<u16> = (0..64 * 64)
+            .map(|i| if (i % 64 + i / 64) % 2 == 0 { 100 } else { 300 })
+            .collect();
+        let f = Frame::new(&board, 64, 64, 12).unwrap();
+        assert!(roughness_permille(&f, (0, 0), &all, 8, 64, 2) > 950);
     }
 }
