@@ -548,8 +548,8 @@ mod tests {
     use super::*;
     use crate::sensor::rng::Xoshiro128pp;
 
-    /// The outline as it was before each pixel was tested once (session 33): the
-    /// right scan over its whole range and the upward pass over every row, the
+    /// The outline as it was before session 33: the right scan over its whole range,
+    /// the upward pass over every row, every step clamped before it is tested; the
     /// reference the faster scans must equal (box and boundary pixels).
     #[allow(clippy::too_many_arguments)]
     fn outline_scanning_twice(
