@@ -171,11 +171,13 @@ pub const ROUGH_MAX_CELLS: usize = 16;
 
 /// The component's roughness, ‰: the share of rough pixels ([`ROUGH_SIGMAS`]) among the
 /// pixels of at most [`ROUGH_MAX_CELLS`] of its 8×8 cells, taken evenly over the
-/// `members` cells marked non-zero in `member` (a plane of `plane.0` cells per row over
+/// `members` cells marked non-zero in `member` (a plane of `plane_w` cells per row over
 /// the window `(x0, y0)` of `frame`, pixels). Second differences along rows, each pixel
 /// clamped to the frame's top DN; the frame's first and last columns are skipped. The
-/// Earth's limb piece or a cloud deck is rough inside, a target's faces are flat (its
-/// outline's pixels count too, a few per row of a cell). 0 without a cell read.
+/// Earth's limb piece or a cloud deck is rough inside, a target's faces are flat, but
+/// its outline's pixels count too (a few per row of each edge cell): over family A's
+/// components the outline dominates and the confidence weighs roughness positively
+/// (docs/detectors.md § Session 33). 0 without a cell read.
 ///
 /// Kept out of line: inlined (through `rate_component` into `run_in`) it cost the M7
 /// +0.37 M instructions on every embedded frame (`scripts/flight.sh`: `run_in`'s hot
