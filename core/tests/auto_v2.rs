@@ -54,6 +54,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
+        any::<bool>(),
     )
         .prop_map(
             |(
@@ -68,6 +69,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
+                spot,
             )| {
                 AutoV2 {
                     prior,
@@ -81,6 +83,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     deep_space,
                     small_target,
                     candidates,
+                    spot,
                 }
             },
         )
@@ -189,7 +192,12 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
             // The confidence is the winner's (what telemetry reads): the saturated
             // blob's when it won, else the classifier's.
             let work = scratch.work();
-            let score = if work.blob_won() {
+            let score = if let Some((roi, score)) = work.spot() {
+                // Stage 5e's box: the other stages answered no target.
+                prop_assert!(det.spot, "{d:?}");
+                prop_assert_eq!(Some(roi), d.roi);
+                score
+            } else if work.blob_won() {
                 prop_assert!(det.blob != BlobRule::Off, "{d:?}");
                 work.blob().expect("a blob won").score_permille()
             } else if work.deep_space().is_some() {

@@ -41,7 +41,7 @@ pub enum SharedScratch {
     Dog(DogScratch),
     /// [`Auto`]'s scratch.
     Auto(AutoScratch),
-    /// [`AutoV2`]'s scratch (48 744 B on x86-64: below DoG's, so the area, and the
+    /// [`AutoV2`]'s scratch (48 760 B on x86-64: below DoG's, so the area, and the
     /// demo's RAM, keep DoG's size).
     AutoV2(AutoV2Scratch),
 }

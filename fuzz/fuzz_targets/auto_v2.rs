@@ -87,6 +87,7 @@ fuzz_target!(|data: &[u8]| {
             _ => BlobRule::Compete,
         },
         candidates: 1 + ((data[2] >> 4) & 3),
+        spot: data[3] & 0x01 == 0,
     };
     let dn: Vec<u16> = data[dn_from..]
         .chunks_exact(2)

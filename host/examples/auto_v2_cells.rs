@@ -28,6 +28,12 @@
 //! the frame's largest saturated blob (`learned::blob::BlobStats`: saturated pixels,
 //! solidity ‰, ring depth ‰, others ‰, sides, its confidence ‰; empty without one),
 //! the blob model's training data (`scripts/train-auto.py --blob`).
+//!
+//! `... -- spots DIR OUT.csv` writes stage 5e's rated spots of every frame (whatever
+//! the other stages answer; `learned::rated_spots`): one line per spot,
+//! `file,k,x,y,x0,y0,x1,y1,score,f0..f16` (the spot's centre, its region's box, the
+//! current forest's confidence ‰ and the features), the spot forest's training data
+//! (`scripts/train-auto.py --spots`).
 mod common;
 
 use std::fmt::Write as _;
@@ -37,7 +43,7 @@ use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, rated_spots,
 };
 use tirroi_host::imaging::image_io::read_frame;
 
@@ -103,7 +109,22 @@ fn main() {
             let f = read_frame(&dir.join(file), Some(*bits)).expect("frame");
             let frame = f.view().expect("view");
             let mut s = String::new();
-            if mode == "features" {
+            if mode == "spots" {
+                let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
+                for (k, r) in rated_spots(&frame, &mut work).iter().enumerate() {
+                    let Some(r) = r else { break };
+                    let b = r.roi;
+                    let _ = write!(
+                        s,
+                        "{file},{k},{},{},{},{},{},{},{}",
+                        r.spot.x, r.spot.y, b.x0, b.y0, b.x1, b.y1, r.score_permille
+                    );
+                    for v in r.features {
+                        let _ = write!(s, ",{v}");
+                    }
+                    s.push('\n');
+                }
+            } else if mode == "features" {
                 let mask = read_frame(&dir.join("masks").join(file), Some(8)).ok();
                 let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
                 for_each_cell_features(&frame, &mut work, |cx, cy, feats| {
@@ -225,7 +246,13 @@ fn main() {
             s
         })
         .collect();
-    let header = if mode == "features" {
+    let header = if mode == "spots" {
+        let mut h = "file,k,x,y,x0,y0,x1,y1,score".to_string();
+        for k in 0..tirroi_core::roi::auto::learned::spot::SPOT_FEATURES {
+            let _ = write!(h, ",f{k}");
+        }
+        h
+    } else if mode == "features" {
         let mut h = "frame,cx,cy,coverage".to_string();
         for k in 0..tirroi_core::roi::auto::learned::features::FEATURES {
             let _ = write!(h, ",f{k}");

@@ -33,8 +33,9 @@ pub const LEAF: u8 = u8::MAX;
 /// Deepest tree walked (a guard: a malformed table cannot loop).
 const MAX_DEPTH: usize = 16;
 
-/// The forest's score of one cell's features: bias + one leaf per tree.
-pub fn score(nodes: &[Node], roots: &[u16], bias: i32, f: &[i32; FEATURES]) -> i32 {
+/// The forest's score of one feature vector (a cell's [`FEATURES`], or another
+/// forest's, `N` of them): bias + one leaf per tree.
+pub fn score<const N: usize>(nodes: &[Node], roots: &[u16], bias: i32, f: &[i32; N]) -> i32 {
     let mut s = bias;
     for &root in roots {
         let mut i = usize::from(root);
@@ -56,6 +57,11 @@ pub fn score(nodes: &[Node], roots: &[u16], bias: i32, f: &[i32; FEATURES]) -> i
 /// Panics (a compile error, in a `const`) on a malformed table: a child index out of
 /// range or a path longer than `MAX_DEPTH`.
 pub const fn max_depth(nodes: &[Node], roots: &[u16]) -> usize {
+    max_depth_of(nodes, roots, FEATURES)
+}
+
+/// [`max_depth`] of a forest over `features` features (every split on one of them).
+pub const fn max_depth_of(nodes: &[Node], roots: &[u16], features: usize) -> usize {
     let mut deepest = 0;
     let mut t = 0;
     while t < roots.len() {
@@ -74,7 +80,7 @@ pub const fn max_depth(nodes: &[Node], roots: &[u16]) -> usize {
                 continue;
             }
             assert!(d < MAX_DEPTH, "a tree deeper than MAX_DEPTH");
-            assert!((n.feature as usize) < FEATURES, "a split on no feature");
+            assert!((n.feature as usize) < features, "a split on no feature");
             stack[top] = (n.left, d + 1);
             stack[top + 1] = (n.right, d + 1);
             top += 2;

@@ -35,6 +35,8 @@ pub mod saturated;
 pub mod shape;
 pub mod small;
 pub mod smooth;
+pub mod spot;
+mod spot_trees;
 
 use super::super::plane::Window;
 use super::super::{BoxRule, DetectError, Detection, Detector, Roi, Scratch};
@@ -118,6 +120,12 @@ pub struct AutoV2 {
     /// is often a cloud deck, the limb or the frame's edge, and the target a weaker
     /// component the confidence model rates higher (`docs/detectors.md` § Session 32).
     pub candidates: u8,
+    /// Stage 5e ([`spot`]): when every other stage answers "no target", the frame's
+    /// strongest small spots against their clutter, each grown to a region and rated by
+    /// its own forest (P(hit)); the most confident one's box when it reaches the gate.
+    /// Default on: on family A (seed 7001) radiometry far (signal-to-clutter ≥ 3) rises
+    /// from 0.03 and no target-less frame is boxed (`docs/detectors.md` § Session 34).
+    pub spot: bool,
 }
 
 /// Confidence of a box of stage 2c (deep space), ‰: its hit rate (IoU ≥ ½) on family
@@ -197,6 +205,7 @@ impl Default for AutoV2 {
             deep_space: true,
             small_target: false,
             candidates: 3,
+            spot: true,
         }
     }
 }
@@ -348,6 +357,7 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     blob: Option<blob::BlobStats>,
     blob_won: bool,
     deep_space: Option<smooth::DeepSpace>,
+    spot: Option<(Roi, u16)>,
 }
 
 impl<C: FrameCapacity> AutoV2Work<C> {
@@ -375,6 +385,13 @@ impl<C: FrameCapacity> AutoV2Work<C> {
     pub fn deep_space(&self) -> Option<smooth::DeepSpace> {
         self.deep_space
     }
+
+    /// Stage 5e's answer on the last frame (its most confident spot's box and
+    /// confidence ‰, whether or not it reached the gate) when the stage ran; `None`
+    /// when another stage answered or the stage is off.
+    pub fn spot(&self) -> Option<(Roi, u16)> {
+        self.spot
+    }
 }
 
 impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
@@ -399,6 +416,7 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         blob: None,
         blob_won: false,
         deep_space: None,
+        spot: None,
     };
 }
 
@@ -425,6 +443,25 @@ pub fn for_each_cell_features<C: FrameCapacity>(
         0
     });
     lv.sigma
+}
+
+/// Stage 5e's spots of the whole `frame`, rated (training data for the spot forest;
+/// the same code the detector runs, [`spot::rated_spots`], with the frame's noise and
+/// levels), whatever the other stages answer.
+pub fn rated_spots<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+) -> [Option<spot::RatedSpot>; spot::SPOTS] {
+    let win = Window::full(frame);
+    let (_, lv) = prepare_cells(frame, work, win);
+    spot::rated_spots(
+        frame,
+        win,
+        &lv,
+        work.sum.as_mut(),
+        work.sum_sq.as_mut(),
+        work.sum_q.as_mut(),
+    )
 }
 
 /// Stages 1–3: prepares the planes ([`prepare`]), computes the features of the 8×8
@@ -722,7 +759,7 @@ pub(crate) fn weighted_logistic_permille(features: &[i32], weights: &[i32], bias
 
 /// Logistic of a score (score units) in ‰, integer: a 33-point table of the logistic
 /// over −8…8 log-odds, linear between.
-fn logistic_permille(score: i32) -> u16 {
+pub(crate) fn logistic_permille(score: i32) -> u16 {
     const TABLE: [u16; 33] = [
         0, 1, 1, 2, 2, 4, 7, 11, 18, 29, 47, 76, 119, 182, 269, 378, 500, 622, 731, 818, 881, 924,
         953, 971, 982, 989, 993, 996, 998, 998, 999, 999, 1000,
@@ -778,6 +815,64 @@ impl AutoV2 {
         // Stages 1–2: noise, cell planes, levels (the integrals after stage 2c, which
         // uses their plane as scratch).
         let (plane8, lv) = prepare_cells(frame, work, win);
+        work.spot = None;
+        let d = self.region_stages(frame, work, win, plane8, lv);
+        if d.roi.is_some() || !self.spot {
+            return d;
+        }
+        self.spot_stage(frame, work, win, lv)
+    }
+
+    /// Stage 5e ([`spot`]) after the other stages answered "no target": the most
+    /// confident spot's box when its confidence reaches the gate (the integral planes,
+    /// used by then, lend the column sums).
+    #[inline(never)]
+    fn spot_stage<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+        lv: FrameLevels,
+    ) -> Detection {
+        let rated = spot::rated_spots(
+            frame,
+            win,
+            &lv,
+            work.sum.as_mut(),
+            work.sum_sq.as_mut(),
+            work.sum_q.as_mut(),
+        );
+        // The most confident; the stronger spot on a tie.
+        let mut best: Option<spot::RatedSpot> = None;
+        for r in rated.iter().flatten() {
+            if best.is_none_or(|b| r.score_permille > b.score_permille) {
+                best = Some(*r);
+            }
+        }
+        let Some(best) = best else {
+            return NO_TARGET;
+        };
+        work.spot = Some((best.roi, best.score_permille));
+        if best.score_permille < self.min_score_permille {
+            return NO_TARGET;
+        }
+        Detection {
+            roi: Some(best.roi),
+            threshold: 0,
+            foreground_px: u32::from(best.roi.width()) * u32::from(best.roi.height()),
+            score_permille: best.score_permille,
+        }
+    }
+
+    /// Stages 2b–8 on the window's planes (every stage but 5e).
+    fn region_stages<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+    ) -> Detection {
         work.winner = None;
         work.blob = None;
         work.blob_won = false;
@@ -1311,7 +1406,7 @@ impl core::fmt::Display for AutoV2 {
             "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
              body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
              body_trim_permille={} prescreen={} blob={:?} deep_space={} small_target={} \
-             candidates={}",
+             candidates={} spot={}",
             self.fine_sigma,
             self.cell_score,
             self.min_score_permille,
@@ -1325,7 +1420,8 @@ impl core::fmt::Display for AutoV2 {
             self.blob,
             self.deep_space,
             self.small_target,
-            self.candidates
+            self.candidates,
+            self.spot
         )
     }
 }
