@@ -1025,10 +1025,11 @@ mod tests {
             strongest_spots(&frame, full, 3, &mut short, &mut b, &mut c),
             [None; SPOTS]
         );
-        // A window of exactly the ring: one centre, which the 3×3 cannot leave.
-        let one = Window::clipped(&frame, 194, 115, 194 + RING_PX, 115 + RING_PX).unwrap();
+        // A window of exactly the ring around the target's centre: one centre, which
+        // the 3×3 cannot leave (its ring misses the 5×4 target).
+        let one = Window::clipped(&frame, 196, 116, 196 + RING_PX, 116 + RING_PX).unwrap();
         let s = strongest_spots(&frame, one, 3, &mut a, &mut b, &mut c);
-        assert!(s.iter().flatten().all(|s| (s.x, s.y) == (200, 121)));
+        assert!(s.iter().flatten().all(|s| (s.x, s.y) == (202, 122)));
         assert!(s[0].is_some(), "the target's corner is a spot");
     }
 }
