@@ -17,8 +17,9 @@
 //! are each grown to a region (the pixels departing [`GROW_SIGMAS`] spreads from the
 //! ring's mean, 8-connected to the centre, within [`REACH_PX`]) and rated by a small
 //! forest of boosted trees (`spot_trees.rs`, `scripts/train-auto.py --spots`) over
-//! [`SPOT_FEATURES`] integer statistics of the spot, its region and its rank among the
-//! frame's spots: the calibrated P(the grown box is a hit). The most confident spot's
+//! [`SPOT_FEATURES`] integer statistics of the spot, its region, its rank among the
+//! frame's spots and its context (does it stand alone, has it hot and cold faces, how
+//! sharp its outline is): the calibrated P(the grown box is a hit). The most confident spot's
 //! box is the answer when it reaches the detector's gate.
 //!
 //! Memory: the column sums of the ring's sampled rows and of the hole's (DN and DN² in
@@ -26,8 +27,8 @@
 //! core's 3 rows, 1 word per column, in the three integral planes the caller lends
 //! (`auto-v2`'s, free at this stage; every capacity's planes hold them). The spots,
 //! their features and the region's bit rows are on the stack (under 700 B).
-//! Cost (Cortex-M7, `scripts/worst-case.sh`): at most 5.67 M instructions per 328×248
-//! window, 70 per pixel: per sampled row the bands (a row in and a row out, of DN and
+//! Cost (Cortex-M7, `scripts/worst-case.sh`): at most 5.49 M instructions per 328×248
+//! window, 67 per pixel: per sampled row the bands (a row in and a row out, of DN and
 //! DN²) and the core's column sums; per centre of the search grid (every second pixel
 //! of every second row) running sums and a comparison, the variance only where the
 //! contrast passes the noise floor, the division and square root only for a centre
@@ -46,7 +47,16 @@ use crate::roi::plane::Window;
 pub const SPOTS: usize = 5;
 
 /// Integer features of a rated spot (the order of [`spot_features`]).
-pub const SPOT_FEATURES: usize = 17;
+pub const SPOT_FEATURES: usize = 21;
+
+/// Half side of the square around a spot whose departing pixels (beyond its region's
+/// box grown by [`CONTEXT_GAP_PX`]) say whether it stands alone, px: 31 px across, two
+/// of the ring's squares (a cloud field's neighbouring cells lie within it).
+pub const CONTEXT_HALF_PX: usize = 15;
+
+/// The context leaves out the region's box grown by this many pixels: the target's
+/// blur.
+pub const CONTEXT_GAP_PX: usize = 2;
 
 /// Side of the spot's core square, px: a 3-px target fills it.
 pub const INNER_PX: usize = 3;
@@ -64,7 +74,8 @@ pub const RING_PX: usize = 13;
 /// (the σ's own relative error ≈ 11 %), and the search's column sums then move by one
 /// sampled row and column per step of the search grid. On the Cortex-M7 the full ring
 /// cost the stage 104 instructions per pixel (`scripts/worst-case.sh`, 8.45 M per
-/// frame), the sampled one 70 (5.67 M); on family A (seed 7001) the sampled ring boxes
+/// frame), the sampled one 70 (5.67 M; 67, 5.49 M with the context features' forest);
+/// on family A (seed 7001) the sampled ring boxes
 /// as well (summed mean IoU 2.226 against 2.217, forest retrained for each).
 pub const RING_STRIDE_PX: usize = 2;
 
@@ -646,7 +657,12 @@ fn region(frame: &Frame<'_>, win: Window, s: &Spot) -> (Roi, u32, bool) {
 /// the box's width and height (px), 10 the region's pixels, 11 their share of the box
 /// (‰), 12 pixels at the top DN and 13 at 0 in the 7×7 around the centre, 14 pixels
 /// from the centre to the window's nearest side, 15 the rank k, 16 whether the region
-/// reached [`REACH_PX`].
+/// reached [`REACH_PX`]; its context (session 34, [`spot_context`]): 17 the share of
+/// the pixels around it departing like it (‰) and 18 departing either way (‰), 19 the
+/// smaller of its box's hottest and coldest departure (1/16 spreads: a body with hot
+/// and cold faces; negative when the whole box lies on one side of the ring's mean),
+/// 20 the largest step between neighbours in a row of its box grown
+/// by a pixel (1/16 spreads: an outline's sharpness).
 fn spot_features(
     frame: &Frame<'_>,
     win: Window,
@@ -656,6 +672,7 @@ fn spot_features(
     s: &Spot,
     (roi, px, edge): (Roi, u32, bool),
 ) -> [i32; SPOT_FEATURES] {
+    let ctx = spot_context(frame, win, s, roi);
     let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
     // Ratios without a panic path (every divisor is ≥ 1 here).
     let ratio = |a: i64, b: i64| a.checked_div(b).unwrap_or(0);
@@ -713,7 +730,90 @@ fn spot_features(
         clamp(edge_px as i64),
         k as i32,
         i32::from(edge),
+        ctx.alike_permille,
+        ctx.any_permille,
+        ctx.both_sixteenths,
+        ctx.step_sixteenths,
     ]
+}
+
+/// A spot's context: [`spot_features`] 17–20.
+struct Context {
+    alike_permille: i32,
+    any_permille: i32,
+    both_sixteenths: i32,
+    step_sixteenths: i32,
+}
+
+/// The context of spot `s` with region box `roi` in window `win` ([`spot_features`]
+/// 17–20): in the square of [`CONTEXT_HALF_PX`] around the centre, outside the box
+/// grown by [`CONTEXT_GAP_PX`], the shares of pixels departing [`GROW_SIGMAS`] spreads
+/// from the ring's mean with the spot's sign and with either; in the box, the smaller
+/// of the hottest and coldest departures; in the box grown by one pixel, the largest
+/// step between row neighbours. At most 31 × 31 + 14 × 15 pixel reads.
+fn spot_context(frame: &Frame<'_>, win: Window, s: &Spot, roi: Roi) -> Context {
+    let (cx, cy) = (usize::from(s.x), usize::from(s.y));
+    let (x_end, y_end) = (win.x0 + win.w, win.y0 + win.h);
+    let px = |v: u16| i64::from(v.min(frame.max_dn()) >> s.shift);
+    let cut = GROW_SIGMAS * s.spread_n as i64;
+    let spread = (s.spread_n as i64).max(1);
+    let sign = if s.colder { -1 } else { 1 };
+    let (bx0, by0) = (usize::from(roi.x0), usize::from(roi.y0));
+    let (bx1, by1) = (usize::from(roi.x1), usize::from(roi.y1));
+    let gap = |v: usize| v.saturating_sub(CONTEXT_GAP_PX);
+    let (gx0, gy0, gx1, gy1) = (
+        gap(bx0),
+        gap(by0),
+        bx1 + CONTEXT_GAP_PX,
+        by1 + CONTEXT_GAP_PX,
+    );
+    let (mut counted, mut alike, mut any) = (0i64, 0i64, 0i64);
+    for y in cy.saturating_sub(CONTEXT_HALF_PX).max(win.y0)..(cy + CONTEXT_HALF_PX + 1).min(y_end) {
+        let row = frame.row(y).unwrap_or(&[]);
+        let inside_rows = (gy0..gy1).contains(&y);
+        for x in
+            cx.saturating_sub(CONTEXT_HALF_PX).max(win.x0)..(cx + CONTEXT_HALF_PX + 1).min(x_end)
+        {
+            if inside_rows && (gx0..gx1).contains(&x) {
+                continue;
+            }
+            let d = row.get(x).map_or(0, |&v| px(v)) * RING_COUNT - s.ring_sum;
+            counted += 1;
+            alike += i64::from(d * sign >= cut);
+            any += i64::from(d.abs() >= cut);
+        }
+    }
+    let (mut hot, mut cold) = (i64::MIN, i64::MAX);
+    let mut step = 0i64;
+    for y in by0.saturating_sub(1).max(win.y0)..(by1 + 1).min(y_end) {
+        let row = frame.row(y).unwrap_or(&[]);
+        let xs = bx0.saturating_sub(1).max(win.x0)..(bx1 + 1).min(x_end);
+        let mut last: Option<i64> = None;
+        for x in xs {
+            let v = row.get(x).map_or(0, |&v| px(v));
+            if let Some(l) = last {
+                step = step.max((v - l).abs());
+            }
+            last = Some(v);
+            if (by0..by1).contains(&y) && (bx0..bx1).contains(&x) {
+                hot = hot.max(v);
+                cold = cold.min(v);
+            }
+        }
+    }
+    let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+    let ratio = |a: i64, b: i64| a.checked_div(b).unwrap_or(0);
+    let both = if hot < cold {
+        0
+    } else {
+        (RING_COUNT * hot - s.ring_sum).min(s.ring_sum - RING_COUNT * cold)
+    };
+    Context {
+        alike_permille: clamp(ratio(1000 * alike, counted)),
+        any_permille: clamp(ratio(1000 * any, counted)),
+        both_sixteenths: clamp(ratio(16 * both, spread)),
+        step_sixteenths: clamp(ratio(16 * RING_COUNT * step, spread)),
+    }
 }
 
 /// Every spot of window `win` rated (strongest first; `None` past the last): the
@@ -1002,6 +1102,84 @@ mod tests {
             },
         );
         assert!(!edge, "the cold block alone");
+    }
+
+    /// The context: an isolated warm block on a flat sky has no departing pixel
+    /// around it and no cold face, and its step is its contrast; the same block in a
+    /// field of warm blocks has its neighbours around it, and a block with a cold half
+    /// has both faces.
+    #[test]
+    fn the_context_tells_a_lone_block_from_a_field() {
+        let flat = |blocks: &[(usize, usize, i32)]| {
+            let mut px = std::vec![2000u16; FRAME_WIDTH * FRAME_HEIGHT];
+            for &(bx, by, c) in blocks {
+                for y in by..by + 4 {
+                    for x in bx..bx + 4 {
+                        px[y * FRAME_WIDTH + x] = (2000 + c) as u16;
+                    }
+                }
+            }
+            px
+        };
+        let spot = Spot {
+            x: 101,
+            y: 101,
+            z16: 100,
+            colder: false,
+            ring_sum: RING_COUNT * 2000,
+            inner_sum: INNER_COUNT * 2300,
+            var_n2: 0,
+            clutter_n: 0,
+            // A spread of 10 DN.
+            spread_n: RING_COUNT as u64 * 10,
+            shift: 0,
+        };
+        let roi = Roi {
+            x0: 100,
+            y0: 100,
+            x1: 104,
+            y1: 104,
+        };
+        let ctx_of = |px: &[u16]| {
+            let frame = Frame::new(px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
+            spot_context(&frame, Window::full(&frame), &spot, roi)
+        };
+        let lone = ctx_of(&flat(&[(100, 100, 300)]));
+        assert_eq!((lone.alike_permille, lone.any_permille), (0, 0));
+        assert_eq!(
+            lone.both_sixteenths,
+            -16 * 300 / 10,
+            "no cold face: its coldest 300 DN above"
+        );
+        assert_eq!(
+            lone.step_sixteenths,
+            16 * 300 / 10,
+            "300 DN in 10-DN spreads"
+        );
+        // Four neighbours 8 px away, 16 px each, in the 31² − 8² = 897 context pixels.
+        let field = ctx_of(&flat(&[
+            (100, 100, 300),
+            (108, 100, 300),
+            (92, 100, 300),
+            (100, 108, 300),
+            (100, 92, 300),
+        ]));
+        assert_eq!(field.alike_permille, 1000 * 64 / 897);
+        assert_eq!(field.any_permille, field.alike_permille);
+        // A cold neighbour counts as departing, not alike.
+        let mixed = ctx_of(&flat(&[(100, 100, 300), (108, 100, -300)]));
+        assert_eq!(
+            (mixed.alike_permille, mixed.any_permille),
+            (0, 1000 * 16 / 897)
+        );
+        // A block with a cold half: both faces, the smaller 200 DN.
+        let mut two = flat(&[(100, 100, 300)]);
+        for y in 102..104 {
+            for x in 100..104 {
+                two[y * FRAME_WIDTH + x] = 1800;
+            }
+        }
+        assert_eq!(ctx_of(&two).both_sixteenths, 16 * 200 / 10);
     }
 
     /// Windows under the ring and short buffers: no spot, no panic.
