@@ -242,16 +242,23 @@ def iou(a, b):
     return i / u if u > 0 else 0.0
 
 
+def truth_boxes(dataset):
+    """File -> truth box (x0, y0, x1, y1; the 0.5-coverage convention) of the rendered
+    folder DATASET's metadata.jsonl, None for a frame without a target."""
+    import json
+    truth = {}
+    for line in open(f"{dataset}/metadata.jsonl"):
+        m = json.loads(line)
+        truth[m["file"]] = m["bbox"] if m.get("target") != "none" else None
+    return truth
+
+
 def confidence(out, pairs):
     import csv
-    import json
     from sklearn.linear_model import LogisticRegression
     xs, ys = [], []
     for pred, dataset in pairs:
-        truth = {}
-        for line in open(f"{dataset}/metadata.jsonl"):
-            m = json.loads(line)
-            truth[m["file"]] = m["bbox"] if m.get("target") != "none" else None
+        truth = truth_boxes(dataset)
         for r in csv.DictReader(open(pred)):
             if not r["cells"]:
                 continue
@@ -300,11 +307,7 @@ def blob_features(r):
 def blob_rows(pred, dataset):
     """(file, features, hit) of every frame of PRED.csv with a saturated blob."""
     import csv
-    import json
-    truth = {}
-    for line in open(f"{dataset}/metadata.jsonl"):
-        m = json.loads(line)
-        truth[m["file"]] = m["bbox"] if m.get("target") != "none" else None
+    truth = truth_boxes(dataset)
     out = []
     for r in csv.DictReader(open(pred)):
         if not r["blob_px"]:
@@ -365,16 +368,12 @@ SPOT_DEPTH, SPOT_TREES = 3, 100
 def spot_rows(spots, dataset):
     """(features, hit) of every spot of SPOTS.csv."""
     import csv
-    import json
-    truth = {}
-    for line in open(f"{dataset}/metadata.jsonl"):
-        m = json.loads(line)
-        truth[m["file"]] = m["bbox"] if m.get("target") != "none" else None
+    truth = truth_boxes(dataset)
     out = []
     for r in csv.DictReader(open(spots)):
         t = truth[r["file"]]
         box = [int(r[k]) for k in ("x0", "y0", "x1", "y1")]
-        feats = [int(r[f"f{k}"]) for k in range(len([c for c in r if c.startswith("f") and c[1:].isdigit()]))]
+        feats = [int(v) for c, v in r.items() if c[:1] == "f" and c[1:].isdigit()]
         out.append((feats, t is not None and iou(box, t) >= 0.5))
     return out
 

@@ -361,6 +361,24 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
 }
 
 impl<C: FrameCapacity> AutoV2Work<C> {
+    /// Stage 5e's rated spots of window `win` ([`spot::rated_spots`]): the integral
+    /// planes, free once the other stages have run, lend its column sums.
+    fn rate_spots(
+        &mut self,
+        frame: &Frame<'_>,
+        win: Window,
+        lv: &FrameLevels,
+    ) -> [Option<spot::RatedSpot>; spot::SPOTS] {
+        spot::rated_spots(
+            frame,
+            win,
+            lv,
+            self.sum.as_mut(),
+            self.sum_sq.as_mut(),
+            self.sum_q.as_mut(),
+        )
+    }
+
     /// What the region stage chose on the last frame.
     pub fn winner(&self) -> Option<Winner> {
         self.winner
@@ -454,14 +472,7 @@ pub fn rated_spots<C: FrameCapacity>(
 ) -> [Option<spot::RatedSpot>; spot::SPOTS] {
     let win = Window::full(frame);
     let (_, lv) = prepare_cells(frame, work, win);
-    spot::rated_spots(
-        frame,
-        win,
-        &lv,
-        work.sum.as_mut(),
-        work.sum_sq.as_mut(),
-        work.sum_q.as_mut(),
-    )
+    work.rate_spots(frame, win, &lv)
 }
 
 /// Stages 1–3: prepares the planes ([`prepare`]), computes the features of the 8×8
@@ -834,14 +845,7 @@ impl AutoV2 {
         win: Window,
         lv: FrameLevels,
     ) -> Detection {
-        let rated = spot::rated_spots(
-            frame,
-            win,
-            &lv,
-            work.sum.as_mut(),
-            work.sum_sq.as_mut(),
-            work.sum_q.as_mut(),
-        );
+        let rated = work.rate_spots(frame, win, &lv);
         // The most confident; the stronger spot on a tie.
         let mut best: Option<spot::RatedSpot> = None;
         for r in rated.iter().flatten() {

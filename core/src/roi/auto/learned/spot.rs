@@ -911,6 +911,15 @@ mod tests {
         (16.0 * (inner - m).abs() / sd.max(sigma), inner < m)
     }
 
+    /// The stage's column-sum buffers for a reference-width window: ring, core, inner.
+    fn buffers() -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+        (
+            std::vec![0u32; 2 * FRAME_WIDTH],
+            std::vec![0u32; 2 * FRAME_WIDTH],
+            std::vec![0u32; FRAME_WIDTH],
+        )
+    }
+
     fn levels(sigma: u32, max_dn: u16) -> FrameLevels {
         FrameLevels {
             p2: 1900,
@@ -925,11 +934,7 @@ mod tests {
 
     fn spots_of(px: &[u16], sigma: u32) -> [Option<Spot>; SPOTS] {
         let frame = Frame::new(px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
-        let (mut a, mut b, mut c) = (
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; FRAME_WIDTH],
-        );
+        let (mut a, mut b, mut c) = buffers();
         strongest_spots(&frame, Window::full(&frame), sigma, &mut a, &mut b, &mut c)
     }
 
@@ -991,11 +996,7 @@ mod tests {
         let px = textured(400);
         let deep: Vec<u16> = px.iter().map(|&v| v * 4 + 3).collect();
         let frame = Frame::new(&deep, FRAME_WIDTH, FRAME_HEIGHT, 14).unwrap();
-        let (mut a, mut b, mut c) = (
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; FRAME_WIDTH],
-        );
+        let (mut a, mut b, mut c) = buffers();
         let s14 = strongest_spots(&frame, Window::full(&frame), 12, &mut a, &mut b, &mut c);
         let s12 = spots_of(&px, 3);
         for (a, b) in s14.iter().zip(&s12) {
@@ -1011,11 +1012,7 @@ mod tests {
         let px = textured(400);
         let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         let win = Window::full(&frame);
-        let (mut a, mut b, mut c) = (
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; FRAME_WIDTH],
-        );
+        let (mut a, mut b, mut c) = buffers();
         let rated = rated_spots(&frame, win, &levels(3, 4095), &mut a, &mut b, &mut c);
         let r = rated[0].expect("rated");
         assert_eq!(
@@ -1046,11 +1043,7 @@ mod tests {
         }
         let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         let win = Window::full(&frame);
-        let (mut a, mut b, mut c) = (
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; FRAME_WIDTH],
-        );
+        let (mut a, mut b, mut c) = buffers();
         let rated = rated_spots(&frame, win, &levels(3, 4095), &mut a, &mut b, &mut c);
         let cold = rated
             .iter()
@@ -1188,11 +1181,7 @@ mod tests {
         let px = textured(400);
         let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         let tiny = Window::clipped(&frame, 0, 0, 12, 40).unwrap();
-        let (mut a, mut b, mut c) = (
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; 2 * FRAME_WIDTH],
-            std::vec![0u32; FRAME_WIDTH],
-        );
+        let (mut a, mut b, mut c) = buffers();
         assert_eq!(
             strongest_spots(&frame, tiny, 3, &mut a, &mut b, &mut c),
             [None; SPOTS]
