@@ -6,8 +6,11 @@
 //!   is 0 signal). Outside the target's coverage it equals the frame's own noise-free
 //!   signal; under the target it is the Earth (or space) the target hides.
 //! - **Target contrast**, DN: |mean over the target mask (coverage ≥ [`MASK_COVERAGE`])
-//!   of (frame signal − twin signal *as the camera sees it*)| × the frame's DN gain
-//!   (noise-free, unquantised). The frame's signal went through the optics PSF and the
+//!   of (frame DN − twin DN *as the camera sees it*)|, both noise-free and unquantised
+//!   but **clipped to the camera's range** 0..=2ⁿ − 1 (session 35: a target below
+//!   DN 0 over deep space at DN 0, or saturated over a saturated Earth, is in no pixel
+//!   of the frame, and the unclipped difference had given such frames SCR up to 10¹⁰
+//!   and a visible share of 1). The frame's signal went through the optics PSF and the
 //!   sensor signature, so the twin does too ([`super::through_the_optics`]): their
 //!   difference is the target's own signal, blurred, with the signature's offsets
 //!   (shading, hot pixels) cancelled. (Before session 26 the raw twin was subtracted,
@@ -16,14 +19,15 @@
 //!   world, nothing changes.)
 //! - **Clutter σ**, DN: the standard deviation of the twin over the ring: the pixels
 //!   within [`ring_width_px`] of the truth box (Chebyshev distance, outside the box,
-//!   cut to the frame), × the DN gain.
+//!   cut to the frame), in DN clipped to the range likewise (a saturated deck shows no
+//!   clutter).
 //! - **SCR** = contrast / max(clutter σ, noise σ, [`QUANTISATION_SIGMA_DN`]). The floor:
 //!   a background flatter than the camera's own noise (deep space, a uniform cloud
 //!   deck) is not what hides the target, and the floor keeps deep space finite; the
 //!   quantisation σ is the floor of a noise-free render.
 //! - **Visible box**: the tight box of the target's pixels (coverage ≥
-//!   [`MASK_COVERAGE`]) whose noise-free signal differs from the background twin *as
-//!   the camera sees it* (twin through the optics PSF and the signature,
+//!   [`MASK_COVERAGE`]) whose noise-free, clipped DN differs from the background twin's
+//!   *as the camera sees it* (twin through the optics PSF and the signature,
 //!   [`super::through_the_optics`]) by at least [`VISIBLE_K_SIGMA`] × max(noise σ,
 //!   [`QUANTISATION_SIGMA_DN`]). A part of the target at its background's level (a cold
 //!   face over deep space, a face at the clouds' temperature) is in the truth box but
@@ -38,6 +42,7 @@
 //! of the window (plus its limb), measured in `docs/scenes.md`.
 
 use tirroi_core::Roi;
+use tirroi_core::sensor::DnMapping;
 
 use super::earth::render_earth;
 use super::pure::PurePixels;
@@ -106,8 +111,9 @@ pub fn ring_window(truth: Roi, width: usize, height: usize) -> Roi {
 /// clutter σ, the scene's own variation), `seen_background` (the twin as the camera
 /// sees it, through the optics and signature like `signal`: the contrast and the
 /// visible box are against it),
-/// `coverage`, all `width` wide; `truth` the ½ box; `gain_dn` DN per signal unit;
-/// `noise_sigma_dn` the frame's noise σ. `None` when the truth box is empty.
+/// `coverage`, all `width` wide; `truth` the ½ box; `mapping` the frame's signal-to-DN
+/// map (every signal is compared as the DN it maps to, clipped to 0..=2ⁿ − 1, not
+/// rounded); `noise_sigma_dn` the frame's noise σ. `None` when the truth box is empty.
 #[allow(clippy::too_many_arguments)]
 pub fn clutter_statistics(
     signal: &[f32],
@@ -116,7 +122,7 @@ pub fn clutter_statistics(
     coverage: &[f32],
     width: usize,
     truth: Roi,
-    gain_dn: f64,
+    mapping: &DnMapping,
     noise_sigma_dn: f64,
 ) -> Option<Clutter> {
     if truth.is_empty() || width == 0 {
@@ -124,6 +130,9 @@ pub fn clutter_statistics(
     }
     let height = signal.len() / width;
     let window = ring_window(truth, width, height);
+    // The DN the camera can show: noise-free, unquantised, within its range.
+    let max_dn = f64::from(mapping.max_dn());
+    let dn = |v: f32| mapping.dn(f64::from(v)).clamp(0.0, max_dn);
     let (mut diff, mut n_mask) = (0f64, 0usize);
     let (mut sum, mut sum2, mut n_ring) = (0f64, 0f64, 0usize);
     let visible_dn = VISIBLE_K_SIGMA * noise_sigma_dn.max(QUANTISATION_SIGMA_DN);
@@ -131,12 +140,12 @@ pub fn clutter_statistics(
     for y in usize::from(window.y0)..usize::from(window.y1) {
         for x in usize::from(window.x0)..usize::from(window.x1) {
             let i = y * width + x;
-            let b = f64::from(background[i]);
+            let b = dn(background[i]);
             if coverage[i] >= MASK_COVERAGE {
-                let d = f64::from(signal[i]) - f64::from(seen_background[i]);
+                let d = dn(signal[i]) - dn(seen_background[i]);
                 diff += d;
                 n_mask += 1;
-                if (d * gain_dn).abs() >= visible_dn {
+                if d.abs() >= visible_dn {
                     (vx0, vy0) = (vx0.min(x), vy0.min(y));
                     (vx1, vy1) = (vx1.max(x + 1), vy1.max(y + 1));
                 }
@@ -155,12 +164,12 @@ pub fn clutter_statistics(
     if n_mask == 0 {
         return None;
     }
-    let contrast = (diff / n_mask as f64 * gain_dn).abs();
+    let contrast = (diff / n_mask as f64).abs();
     let sigma = if n_ring == 0 {
         0.0
     } else {
         let m = sum / n_ring as f64;
-        (sum2 / n_ring as f64 - m * m).max(0.0).sqrt() * gain_dn.abs()
+        (sum2 / n_ring as f64 - m * m).max(0.0).sqrt()
     };
     let floor = sigma.max(noise_sigma_dn).max(QUANTISATION_SIGMA_DN);
     // Inside the window, which is at most 1024 px wide (`u16` boxes).
@@ -231,7 +240,7 @@ pub fn signal_to_clutter(
         &frame.coverage,
         w,
         frame.truth,
-        frame.mapping.gain_dn(),
+        &frame.mapping,
         f64::from(frame.noise_sigma_dn),
     ))
 }
@@ -239,6 +248,12 @@ pub fn signal_to_clutter(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 16-bit map of gain `g` DN per unit and no offset: far from the range's ends
+    /// for the backgrounds below.
+    fn gain(g: f64) -> DnMapping {
+        DnMapping::new(g, 0.0, 16).unwrap()
+    }
 
     /// A uniform disc of contrast `c` (coverage 1 inside radius `r`, 0 outside) over a
     /// checkerboard background `b0 ± a`.
@@ -277,17 +292,17 @@ mod tests {
         assert_eq!(truth, Roi::new(15, 15, 25, 25));
         assert_eq!(ring_width_px(truth), 5);
         assert_eq!(ring_window(truth, w, h), Roi::new(10, 10, 30, 30));
-        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &gain(g), 0.5).unwrap();
         let close = |x: f64, y: f64| (x - y).abs() < 1e-9 * y.abs().max(1.0);
         assert!(close(got.target_contrast_dn, f64::from(c) * g), "{got:?}");
         assert!(close(got.clutter_sigma_dn, f64::from(a) * g), "{got:?}");
         assert!(close(got.signal_to_clutter, f64::from(c / a)), "{got:?}");
         // A noise σ above the clutter becomes the denominator.
-        let noisy = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 60.0).unwrap();
+        let noisy = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &gain(g), 60.0).unwrap();
         assert!(close(noisy.signal_to_clutter, f64::from(c) * g / 60.0));
         // A flat background, no noise: the quantisation floor 1/√12 DN.
         let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, c, b0, 0.0);
-        let flat = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.0).unwrap();
+        let flat = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &gain(g), 0.0).unwrap();
         assert_eq!(flat.clutter_sigma_dn, 0.0);
         assert!(close(
             flat.signal_to_clutter,
@@ -295,7 +310,7 @@ mod tests {
         ));
         // A darker target: the contrast's magnitude.
         let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, -c, b0, a);
-        let dark = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, g, 0.5).unwrap();
+        let dark = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &gain(g), 0.5).unwrap();
         assert!(close(dark.target_contrast_dn, f64::from(c) * g));
     }
 
@@ -317,20 +332,20 @@ mod tests {
         }
         let truth = super::super::mask_box(&cov, w);
         assert_eq!(truth, Roi::new(10, 12, 20, 18));
-        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, 1.0, 1.0).unwrap();
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &gain(1.0), 1.0).unwrap();
         assert_eq!(got.visible, Roi::new(10, 12, 14, 18));
         assert!((got.visible_share(truth) - 0.4).abs() < 1e-12);
         // Darker pixels count by their magnitude; a gain of 2 DN per unit doubles the
         // contrast in DN: 2.9 → 5.8 DN ≥ 3 DN, so everything is visible.
         let dark: Vec<f32> = sig.iter().zip(&bg).map(|(s, b)| 2.0 * b - s).collect();
-        let got = clutter_statistics(&dark, &bg, &bg, &cov, w, truth, 2.0, 1.0).unwrap();
+        let got = clutter_statistics(&dark, &bg, &bg, &cov, w, truth, &gain(2.0), 1.0).unwrap();
         assert_eq!(got.visible, truth);
         assert_eq!(got.visible_share(truth), 1.0);
         // The camera's offsets: a seen background 10 units above the twin (a
         // signature offset the frame's signal carries too) is what the target is
         // compared with, so a target at exactly that offset is invisible.
         let seen: Vec<f32> = bg.iter().map(|b| b + 10.0).collect();
-        let got = clutter_statistics(&sig, &bg, &seen, &cov, w, truth, 1.0, 1.0).unwrap();
+        let got = clutter_statistics(&sig, &bg, &seen, &cov, w, truth, &gain(1.0), 1.0).unwrap();
         assert_eq!(
             got.visible,
             Roi::new(14, 12, 20, 18),
@@ -342,9 +357,45 @@ mod tests {
             "{got:?}"
         );
         let flat: Vec<f32> = bg.iter().map(|b| b + 10.0).collect();
-        let got = clutter_statistics(&flat, &bg, &seen, &cov, w, truth, 1.0, 1.0).unwrap();
+        let got = clutter_statistics(&flat, &bg, &seen, &cov, w, truth, &gain(1.0), 1.0).unwrap();
         assert!(got.visible.is_empty());
         assert_eq!(got.visible_share(truth), 0.0);
+    }
+
+    #[test]
+    fn pixels_clipped_to_the_background_level_are_not_seen() {
+        // A 12-bit map DN = 10·s − 500 (s = 50 ↦ DN 0, s = 459.5 ↦ 4095). Over a
+        // background at s = 40 (DN −100, shown as 0) a target at s = 45 (DN −50, also
+        // 0) is in no pixel: contrast 0, nothing visible, SCR 0. At s = 60 (DN 100)
+        // it stands 100 DN above the shown 0, not the unclipped 200.
+        let map = DnMapping::new(10.0, -500.0, 12).unwrap();
+        let (w, h) = (40, 40);
+        let disc = |t: f32, b: f32| disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, t - b, b, 0.0);
+        let (sig, bg, cov) = disc(45.0, 40.0);
+        let truth = super::super::mask_box(&cov, w);
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &map, 1.0).unwrap();
+        assert_eq!(got.target_contrast_dn, 0.0, "{got:?}");
+        assert_eq!(got.signal_to_clutter, 0.0);
+        assert!(got.visible.is_empty());
+        let (sig, bg, cov) = disc(60.0, 40.0);
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &map, 1.0).unwrap();
+        assert!((got.target_contrast_dn - 100.0).abs() < 1e-9, "{got:?}");
+        assert_eq!(got.visible, truth);
+        // Saturation alike: a target at s = 600 over a background at s = 500 (DN 4500
+        // and 4095 → both 4095) is invisible; over s = 450 (DN 4000) it stands 95 DN.
+        let (sig, bg, cov) = disc(600.0, 500.0);
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &map, 1.0).unwrap();
+        assert_eq!(got.target_contrast_dn, 0.0, "{got:?}");
+        assert!(got.visible.is_empty());
+        let (sig, bg, cov) = disc(600.0, 450.0);
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &map, 1.0).unwrap();
+        assert!((got.target_contrast_dn - 95.0).abs() < 1e-9, "{got:?}");
+        // The clutter is the shown background's: a checkerboard 440 ± 20 (DN 3900 ±
+        // 200) is cut at 4095 on its bright squares, so its σ is (3700 … 4095)'s half
+        // difference, 197.5 DN, not 200.
+        let (sig, bg, cov) = disc_on_checkerboard(w, h, (20.0, 20.0), 5.0, 10.0, 440.0, 20.0);
+        let got = clutter_statistics(&sig, &bg, &bg, &cov, w, truth, &map, 1.0).unwrap();
+        assert!((got.clutter_sigma_dn - 197.5).abs() < 1e-9, "{got:?}");
     }
 
     #[test]
@@ -354,7 +405,7 @@ mod tests {
         assert_eq!(ring_window(truth, 5, 50), Roi::new(0, 0, 5, 6));
         let z = vec![0f32; 16];
         assert_eq!(
-            clutter_statistics(&z, &z, &z, &z, 4, Roi::EMPTY, 1.0, 0.0),
+            clutter_statistics(&z, &z, &z, &z, 4, Roi::EMPTY, &gain(1.0), 0.0),
             None
         );
         assert_eq!(QUANTISATION_SIGMA_DN, 1.0 / 12f64.sqrt());
