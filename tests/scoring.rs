@@ -458,7 +458,9 @@ fn no_target_poses_leave_the_other_frames_unchanged() {
 fn signal_to_clutter_against_a_full_frame_twin() {
     // The windowed twin of the renderer against a brute-force one: the same plan
     // rendered whole without its target and without noise; the ring enumerated by
-    // Chebyshev distance to the truth box.
+    // Chebyshev distance to the truth box; every signal compared as the DN the camera
+    // shows (unquantised, clipped to its range: a saturated target over a saturated
+    // Earth stands out by nothing).
     let file = SceneFile::parse(TINY, "TINY").unwrap();
     let plans = plan(&file);
     let library = Library::build(&file, &plans).unwrap();
@@ -473,7 +475,8 @@ fn signal_to_clutter_against_a_full_frame_twin() {
         let got = frame.clutter.expect("a target in view");
         let (w, h) = (frame.width, frame.height);
         let t = frame.truth;
-        let gain = frame.mapping.gain_dn();
+        let max_dn = f64::from(frame.mapping.max_dn());
+        let dn = |v: f32| frame.mapping.dn(f64::from(v)).clamp(0.0, max_dn);
         let (mut diff, mut n) = (0.0, 0usize);
         let mut ring = Vec::new();
         let band = 4usize.max(usize::from(t.width().max(t.height())).div_ceil(2)) as i64;
@@ -481,21 +484,21 @@ fn signal_to_clutter_against_a_full_frame_twin() {
             for x in 0..w {
                 let i = y * w + x;
                 if frame.coverage[i] >= 0.5 {
-                    diff += f64::from(frame.signal[i]) - f64::from(twin.signal[i]);
+                    diff += dn(frame.signal[i]) - dn(twin.signal[i]);
                     n += 1;
                 }
                 let dx = (i64::from(t.x0) - x as i64).max(x as i64 - (i64::from(t.x1) - 1));
                 let dy = (i64::from(t.y0) - y as i64).max(y as i64 - (i64::from(t.y1) - 1));
                 let d = dx.max(dy);
                 if (1..=band).contains(&d) {
-                    ring.push(f64::from(twin.signal[i]));
+                    ring.push(dn(twin.signal[i]));
                 }
             }
         }
-        let contrast = (diff / n as f64 * gain).abs();
+        let contrast = (diff / n as f64).abs();
         let mean = ring.iter().sum::<f64>() / ring.len() as f64;
         let var = ring.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / ring.len() as f64;
-        let sigma = var.sqrt() * gain.abs();
+        let sigma = var.sqrt();
         let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-12);
         // The window's limb pixels on its edge may miss their supersampling (the
         // module's docs): a per-mille difference at most on these frames.
