@@ -4,7 +4,7 @@
 # scene rendered as it is, with one factor turned back to the paper world's, and with
 # the four camera/Earth factors off and then one scene factor more, COUNT frames each
 # from SEED (the same seed for every variant), scored by `auto_v2_cells predict` and
-# the mean IoU of the frames with a target (½ truth) printed per variant.
+# the mean IoU of the frames with a target (½ truth, `tirroi eval`) printed per variant.
 #
 #   scripts/ablation-radiometry-close.sh [COUNT] [SEED] [OUT_DIR]
 #
@@ -73,25 +73,12 @@ with open(f"{out}/variants.txt", "w") as f:
 PY
 printf '| variant | frames with a target | auto-v2 mean IoU (½) |\n|---|---|---|\n'
 while read -r name erode; do
-    rm -rf "${out:?}/$name"
+    rm -rf "${out:?}/$name" "${out:?}/$name-eval"
     "$tirroi" render --config "$out/$name.toml" --count "$count" --seed "$seed" --out "$out/$name" > /dev/null 2>&1
     "$predict" predict "$out/$name" "$out/$name.csv" 0 "$erode" > /dev/null 2>&1
-    python3 - "$out/$name" "$out/$name.csv" "$name" <<'PY'
-import csv, sys
-d, pred, name = sys.argv[1:4]
-truth = {r["file"]: r for r in csv.DictReader(open(f"{d}/truth.csv"))}
-boxes = {r["file"]: r for r in csv.DictReader(open(pred))}
-def iou(a, b):
-    ix = max(0, min(a[2], b[2]) - max(a[0], b[0])); iy = max(0, min(a[3], b[3]) - max(a[1], b[1]))
-    i = ix * iy; u = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - i
-    return i / u if u > 0 else 0.0
-scores = []
-for f, t in truth.items():
-    if t["x0"] == "":
-        continue
-    p = boxes.get(f)
-    box = lambda r: [int(float(r[k])) for k in ("x0", "y0", "x1", "y1")]
-    scores.append(iou(box(t), box(p)) if p and p["x0"] != "" else 0.0)
-print(f"| {name} | {len(scores)} | {sum(scores) / len(scores):.3f} |")
-PY
+    # The mean IoU of the frames with a target, ½ truth: `tirroi eval`'s "all" row.
+    "$tirroi" eval --images "$out/$name" --method none --predictions "v2=$out/$name.csv" \
+        --out "$out/$name-eval" > /dev/null 2>&1
+    awk -F, -v n="$name" '$1 == "v2" && $2 == "all" { printf "| %s | %s | %.3f |\n", n, $10, $5 }' \
+        "$out/$name-eval/summary.csv"
 done < "$out/variants.txt"

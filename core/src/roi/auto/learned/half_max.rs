@@ -97,6 +97,24 @@ fn ring_median(frame: &Frame<'_>, roi: Roi) -> Option<u16> {
     u16::try_from(median).ok()
 }
 
+/// The strongest departure from `bg` of the sign of `d` among pixel (x, y)'s 3 × 3
+/// inside `roi` (its own included): the level of the face it lies on.
+fn face_level(frame: &Frame<'_>, roi: Roi, x: usize, y: usize, d: i32, bg: i32) -> u32 {
+    let x_end = (x + 2).min(usize::from(roi.x1)).min(frame.width());
+    let xs = x.saturating_sub(1).max(usize::from(roi.x0))..x_end;
+    let ys = y.saturating_sub(1).max(usize::from(roi.y0))..(y + 2).min(usize::from(roi.y1));
+    let mut face = 0u32;
+    for yy in ys {
+        for &v in frame.row(yy).and_then(|r| r.get(xs.clone())).unwrap_or(&[]) {
+            let e = i32::from(v) - bg;
+            if e.signum() == d.signum() {
+                face = face.max(e.unsigned_abs());
+            }
+        }
+    }
+    face
+}
+
 /// `roi` cut to its half maximum and its weaker faces' (see the module): boxes larger than
 /// [`MAX_SIDE_PX`], or whose peak departs less than [`MIN_PEAK_SIGMA`] · `sigma_dn`
 /// from the ring's median, come back unchanged. The result lies inside `roi` and
@@ -133,13 +151,6 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32) -> Roi {
     }
     let face_min =
         (FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1))).max(peak.unsigned_abs() / FACE_SHARE_DIV);
-    // The departure of pixel (x, y) of the box (0 outside the frame).
-    let departure = |x: usize, y: usize| -> i32 {
-        frame
-            .row(y)
-            .and_then(|r| r.get(x))
-            .map_or(0, |&v| i32::from(v) - bg)
-    };
     let mut cut = Roi::EMPTY;
     let mut found = false;
     for y in rows.clone() {
@@ -151,19 +162,8 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32) -> Roi {
             // Above half the peak (its sign), or at its own face's half maximum
             // (either sign: a cold face beside a hot one; module docs).
             let kept = d.signum() == peak.signum() && 2 * d.abs() > peak.abs()
-                || d.unsigned_abs() >= face_min && {
-                    let x = x0 + i;
-                    let mut face = 0u32;
-                    for yy in y.saturating_sub(1).max(rows.start)..(y + 2).min(rows.end) {
-                        for xx in x.saturating_sub(1).max(x0)..(x + 2).min(x1) {
-                            let e = departure(xx, yy);
-                            if e.signum() == d.signum() {
-                                face = face.max(e.unsigned_abs());
-                            }
-                        }
-                    }
-                    2 * d.unsigned_abs() > face
-                };
+                || d.unsigned_abs() >= face_min
+                    && 2 * d.unsigned_abs() > face_level(frame, roi, x0 + i, y, d, bg);
             if kept {
                 let (x, y) = ((x0 + i) as u16, y as u16);
                 if found {
