@@ -105,6 +105,14 @@ def load(paths):
     return np.concatenate(xs), np.concatenate(ys)
 
 
+def fit_forest(x, y, depth, trees):
+    """Boosted trees of `depth` (`trees` of them) fitted to hits `y` of features `x`:
+    learning rate 0.1, no early stopping, a fixed random state (reproducible tables)."""
+    clf = HistGradientBoostingClassifier(max_depth=depth, max_iter=trees, learning_rate=0.1,
+                                         early_stopping=False, random_state=0)
+    return clf.fit(x, y)
+
+
 def write_forest(out, clf, generator, about, bias_doc):
     """Writes the fitted HistGradientBoostingClassifier `clf` as a node table
     (`forest::Node`): leaf values and the bias × SCORE_ONE rounded, thresholds floored."""
@@ -138,9 +146,7 @@ def write_forest(out, clf, generator, about, bias_doc):
 def main():
     out, paths = sys.argv[1], sys.argv[2:]
     x, y = load(paths)
-    clf = HistGradientBoostingClassifier(max_depth=DEPTH, max_iter=TREES, learning_rate=0.1,
-                                         early_stopping=False, random_state=0)
-    clf.fit(x, y)
+    clf = fit_forest(x, y, DEPTH, TREES)
     nodes, roots, bias = write_forest(
         out, clf, "scripts/train-auto.py",
         f"{TREES} trees of depth {DEPTH}; trained on {len(y)} cells ({int(y.sum())} target) of: "
@@ -382,9 +388,7 @@ def spots(out, pairs):
     rows = [row for sp, dataset in pairs for row in spot_rows(sp, dataset)]
     x = np.array([f for f, _ in rows], dtype=np.int64)
     y = np.array([h for _, h in rows])
-    clf = HistGradientBoostingClassifier(max_depth=SPOT_DEPTH, max_iter=SPOT_TREES, learning_rate=0.1,
-                                         early_stopping=False, random_state=0)
-    clf.fit(x, y)
+    clf = fit_forest(x, y, SPOT_DEPTH, SPOT_TREES)
     nodes, roots, bias = write_forest(
         out, clf, "scripts/train-auto.py --spots",
         f"{SPOT_TREES} trees of depth {SPOT_DEPTH}; trained on {len(y)} spots ({int(y.sum())} hits) of: "
