@@ -915,12 +915,9 @@ impl AutoV2 {
             |_, _, feats| {
                 // The flat form of `forest_trees.rs` (built at compile time; the same
                 // score as walking its nodes, `forest::score`).
-                let s = forest::FLIGHT.score(feats);
-                let above = s - cell_score;
-                if above >= 0 {
-                    (1 + above / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8
-                } else {
-                    0
+                match forest::FLIGHT.score_reaching(feats, cell_score) {
+                    Some(s) => (1 + (s - cell_score) / (forest::SCORE_ONE / 4)).clamp(1, 255) as u8,
+                    None => 0,
                 }
             },
         );
