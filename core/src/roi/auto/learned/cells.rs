@@ -77,7 +77,11 @@ pub fn fill_cells(
                 // An inner cell (a pixel on each side, both neighbouring rows): the same
                 // sums and steps from slices, without a bounds check per read.
                 if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
-                    let (acc, best, n_sat) = inner_cell(row, u, d, xa, xb, max_dn, *st);
+                    let (acc, best, n_sat) = if xb - xa == CELL_PX {
+                        full_inner_cell(row, u, d, xa, max_dn, *st)
+                    } else {
+                        inner_cell(row, u, d, xa, xb, max_dn, *st)
+                    };
                     *s += acc;
                     *st = best;
                     *sat = sat.saturating_add(n_sat);
@@ -167,6 +171,42 @@ fn inner_cell(
         acc += u32::from(v.min(max_dn));
         let h = l.min(max_dn).abs_diff(r.min(max_dn));
         let vert = u.min(max_dn).abs_diff(d.min(max_dn));
+        best = best.max(h).max(vert);
+    }
+    (acc, best, n_sat)
+}
+
+/// [`inner_cell`] of a whole cell row (`xb = xa + CELL_PX`) on fixed-size arrays: each
+/// pixel of the row clamped once (it is the left, centre and right neighbour of three),
+/// the loop unrolled. The same sums and steps; `(0, best, 0)` for slices out of range.
+#[inline(always)]
+fn full_inner_cell(
+    row: &[u16],
+    up: &[u16],
+    down: &[u16],
+    xa: usize,
+    max_dn: u16,
+    best: u16,
+) -> (u32, u16, u8) {
+    let (Some(around), Some(up), Some(down)) = (
+        row.get(xa.wrapping_sub(1)..xa + CELL_PX + 1)
+            .and_then(|r| <&[u16; CELL_PX + 2]>::try_from(r).ok()),
+        up.get(xa..xa + CELL_PX)
+            .and_then(|r| <&[u16; CELL_PX]>::try_from(r).ok()),
+        down.get(xa..xa + CELL_PX)
+            .and_then(|r| <&[u16; CELL_PX]>::try_from(r).ok()),
+    ) else {
+        return (0, best, 0);
+    };
+    let clamped = around.map(|v| v.min(max_dn));
+    let mut acc = 0u32;
+    let mut best = best;
+    let mut n_sat = 0u8;
+    for i in 0..CELL_PX {
+        n_sat += u8::from(around[i + 1] >= max_dn);
+        acc += u32::from(clamped[i + 1]);
+        let h = clamped[i].abs_diff(clamped[i + 2]);
+        let vert = up[i].min(max_dn).abs_diff(down[i].min(max_dn));
         best = best.max(h).max(vert);
     }
     (acc, best, n_sat)
