@@ -241,6 +241,11 @@ pub fn sub_window_extremes(frame: &Frame<'_>, win: Window, (cx, cy): (usize, usi
     if xa >= xb || ya >= yb {
         return (0, 0);
     }
+    if xb - xa == CELL_PX && yb - ya == CELL_PX {
+        if let Some(extremes) = full_cell_extremes(frame, xa, ya) {
+            return extremes;
+        }
+    }
     // Sums and pixel counts of the 2×2-pixel blocks of the cell.
     let mut sums = [[0u32; BLOCKS]; BLOCKS];
     let mut counts = [[0u32; BLOCKS]; BLOCKS];
@@ -290,11 +295,111 @@ pub fn sub_window_extremes(frame: &Frame<'_>, win: Window, (cx, cy): (usize, usi
     )
 }
 
+/// [`sub_window_extremes`] of a whole 8×8 cell at `(xa, ya)` on fixed-size arrays (every
+/// window full: no counts; 2 × 2 blocks of 2 × 2 pixels per window); `None` if a row
+/// were out of the frame (never for a cell of a window).
+#[inline(always)]
+fn full_cell_extremes(frame: &Frame<'_>, xa: usize, ya: usize) -> Option<(u16, u16)> {
+    let max_dn = frame.max_dn();
+    // Sums of the 2×2-pixel blocks.
+    const { assert!(SUB_STRIDE_PX == 2 && SUB_PX == 2 * SUB_STRIDE_PX) };
+    let mut blocks = [[0u32; BLOCKS]; BLOCKS];
+    for dy in 0..CELL_PX {
+        let row = frame.row(ya + dy)?.get(xa..xa + CELL_PX)?;
+        let row = <&[u16; CELL_PX]>::try_from(row).ok()?;
+        let sums = blocks.get_mut(dy / SUB_STRIDE_PX)?;
+        for (bx, s) in sums.iter_mut().enumerate() {
+            *s += u32::from(row[2 * bx].min(max_dn)) + u32::from(row[2 * bx + 1].min(max_dn));
+        }
+    }
+    let full = (SUB_PX * SUB_PX) as u32;
+    let (mut hot, mut cold) = (0u32, u32::MAX);
+    for wy in 0..SUB_WINDOWS {
+        for wx in 0..SUB_WINDOWS {
+            let s =
+                blocks[wy][wx] + blocks[wy][wx + 1] + blocks[wy + 1][wx] + blocks[wy + 1][wx + 1];
+            let m = s / full;
+            hot = hot.max(m);
+            cold = cold.min(m);
+        }
+    }
+    Some((hot as u16, cold as u16))
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
     use super::*;
     use std::vec::Vec;
+
+    /// The hottest and coldest 4×4 windows against a brute force over every window at
+    /// a 2-px stride wholly inside the cell and the window (pixels clamped to the top
+    /// DN; the cell's mean without one), on odd frame sizes, an offset window (partial
+    /// cells on every side) and values above the top DN.
+    #[test]
+    fn sub_window_extremes_equal_brute_force() {
+        let mut seed = 0x9E37_79B9u32;
+        let mut windows = 0u32;
+        for (w, h, bits, win) in [
+            (37usize, 29usize, 12u8, None),
+            (328, 248, 14, None),
+            (61, 45, 14, Some((5usize, 3usize, 50usize, 39usize))),
+            (9, 3, 8, None),
+        ] {
+            let px: Vec<u16> = (0..w * h)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 17;
+                    seed ^= seed << 5;
+                    (seed % 20_000) as u16
+                })
+                .collect();
+            let frame = Frame::new(&px, w, h, bits).unwrap();
+            let win = match win {
+                None => Window::full(&frame),
+                Some((x0, y0, x1, y1)) => Window::clipped(&frame, x0, y0, x1, y1).unwrap(),
+            };
+            let top = u64::from(frame.max_dn());
+            let at = |x: usize, y: usize| u64::from(px[y * w + x]).min(top);
+            let (pw, ph) = cell_plane(win);
+            for cy in 0..ph {
+                for cx in 0..pw {
+                    let (xa, ya) = (win.x0 + cx * CELL_PX, win.y0 + cy * CELL_PX);
+                    let xb = (xa + CELL_PX).min(win.x0 + win.w);
+                    let yb = (ya + CELL_PX).min(win.y0 + win.h);
+                    let (mut hot, mut cold) = (None::<u64>, None::<u64>);
+                    for y in (ya..yb).step_by(SUB_STRIDE_PX).filter(|y| y + SUB_PX <= yb) {
+                        for x in (xa..xb).step_by(SUB_STRIDE_PX).filter(|x| x + SUB_PX <= xb) {
+                            let mut s = 0u64;
+                            for yy in y..y + SUB_PX {
+                                for xx in x..x + SUB_PX {
+                                    s += at(xx, yy);
+                                }
+                            }
+                            let m = s / (SUB_PX * SUB_PX) as u64;
+                            hot = Some(hot.map_or(m, |v| v.max(m)));
+                            cold = Some(cold.map_or(m, |v| v.min(m)));
+                            windows += 1;
+                        }
+                    }
+                    let (mut s, mut n) = (0u64, 0u64);
+                    for y in ya..yb {
+                        for x in xa..xb {
+                            s += at(x, y);
+                            n += 1;
+                        }
+                    }
+                    let want = (hot.unwrap_or(s / n) as u16, cold.unwrap_or(s / n) as u16);
+                    assert_eq!(
+                        sub_window_extremes(&frame, win, (cx, cy)),
+                        want,
+                        "{w}x{h} cell ({cx}, {cy})"
+                    );
+                }
+            }
+        }
+        assert!(windows > 10_000, "{windows}");
+    }
 
     /// The cell plane against a brute force over the pixels (sum, the largest clamped
     /// two-pixel step across and down, neighbours clamped at the frame's edges, and the

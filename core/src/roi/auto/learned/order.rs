@@ -34,7 +34,9 @@ pub fn select_binned<I: Iterator<Item = u32>>(values: impl Fn() -> I, k: usize, 
         let mut counts = [0u32; SELECT_BINS];
         for v in values() {
             if (lo..=hi).contains(&v) {
-                let bin = (u64::from(v - lo) / width) as usize;
+                // In u32 (a hardware divide on the M7; u64 is a library call): both fit,
+                // `v − lo` ≤ `hi − lo` and `width` ≤ 2³² / SELECT_BINS.
+                let bin = ((v - lo) / width as u32) as usize;
                 if let Some(c) = counts.get_mut(bin.min(SELECT_BINS - 1)) {
                     *c += 1;
                 }
