@@ -25,6 +25,8 @@
 //! `slog` its signed form; a box is cut to the plane (its mean and standard deviation
 //! `sd` over the cells inside).
 
+use super::narrow::{div_i64, div_u64, isqrt_u64};
+
 /// Features per cell: 5 of the cell, 4 per context box, 6 of its 4×4-pixel windows,
 /// 5 against the frame's ends, the windows' spread, either sign and the frame's edge,
 /// and the step's rank in the frame.
@@ -65,7 +67,7 @@ pub fn log_code(v: u32) -> i32 {
 
 /// [`log_code`] of `|d| · 4 / σ` with the sign of `d`.
 fn slog(d: i64, sigma: u32) -> i32 {
-    let q = (d.unsigned_abs() * 4 / u64::from(sigma.max(1))).min(u64::from(u32::MAX)) as u32;
+    let q = div_u64(d.unsigned_abs() * 4, u64::from(sigma.max(1))).min(u64::from(u32::MAX)) as u32;
     if d < 0 { -log_code(q) } else { log_code(q) }
 }
 
@@ -245,7 +247,7 @@ pub fn cell_features(
     // this function is not inlined into its caller (the cascade's classify closure).
     let s = lv.sigma.max(1);
     let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(s));
-    out[0] = ((m - i64::from(lv.p50)) * 256 / range).clamp(-4096, 4096) as i32;
+    out[0] = div_i64((m - i64::from(lv.p50)) * 256, range).clamp(-4096, 4096) as i32;
     out[1] = slog(m - i64::from(lv.p2), s);
     out[2] = slog(i64::from(lv.p98) - m, s);
     out[3] = i32::from(step_code.get(i).copied().unwrap_or(0));
@@ -259,12 +261,12 @@ pub fn cell_features(
         // removes the division's panic path.
         let n = (((x1 - x0 + 1) * (y1 - y0 + 1)) as u64).max(1);
         let (sum, sum_q, sum_sq, edges) = box_sums(ints, pw, (x0, y0, x1, y1));
-        let mean = (sum / n) as i64;
+        let mean = div_u64(sum, n) as i64;
         // Variance of q in 1/n² units: (n Σq² − (Σq)²) / n².
         let var_n2 = (n * sum_sq).saturating_sub(sum_q * sum_q);
-        let sd = ((var_n2.isqrt() / n) << lv.sd_shift) as i64;
+        let sd = (div_u64(isqrt_u64(var_n2), n) << lv.sd_shift) as i64;
         if k == 0 && n > 1 {
-            reference = sum.saturating_sub(m as u64).checked_div(n - 1).unwrap_or(0) as i64;
+            reference = div_u64(sum.saturating_sub(m as u64), n - 1) as i64;
         }
         if k == 1 {
             sd2 = sd.max(i64::from(s));
@@ -272,16 +274,17 @@ pub fn cell_features(
         let d = m - mean;
         let o = 5 + 4 * k;
         out[o] = slog(d, s);
-        out[o + 1] = (d * 16 / sd.max(i64::from(s)))
+        out[o + 1] = div_i64(d * 16, sd.max(i64::from(s)))
             .clamp(-i64::from(CONTRAST_CLAMP), i64::from(CONTRAST_CLAMP))
             as i32;
-        out[o + 2] = (u64::from(edges) * 256 / n) as i32;
-        out[o + 3] = log_code((sd as u64 * 4 / u64::from(s)).min(u64::from(u32::MAX)) as u32);
+        out[o + 2] = div_u64(u64::from(edges) * 256, n) as i32;
+        out[o + 3] = log_code(div_u64(sd as u64 * 4, u64::from(s)).min(u64::from(u32::MAX)) as u32);
     }
     let (hot, cold) = (i64::from(hot), i64::from(cold));
     let o = 5 + 4 * RADII_CELLS.len();
-    let clutter =
-        |d: i64| (d * 16 / sd2).clamp(-i64::from(CONTRAST_CLAMP), i64::from(CONTRAST_CLAMP)) as i32;
+    let clutter = |d: i64| {
+        div_i64(d * 16, sd2).clamp(-i64::from(CONTRAST_CLAMP), i64::from(CONTRAST_CLAMP)) as i32
+    };
     out[o] = slog(hot - reference, s);
     out[o + 1] = slog(cold - reference, s);
     out[o + 2] = clutter(hot - reference);

@@ -29,6 +29,7 @@ pub mod features;
 pub mod forest;
 mod forest_trees;
 pub mod half_max;
+pub mod narrow;
 pub mod order;
 pub mod prescreen;
 pub mod saturated;
