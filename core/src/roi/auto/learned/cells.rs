@@ -61,6 +61,8 @@ pub fn fill_cells(
             .get_mut(cy * pw..(cy + 1) * pw)
             .unwrap_or_default();
         sat_row.fill(0);
+        // Whole cells with a frame row above and below: a block at a time.
+        let block_rows = ya >= 1 && yb == ya + CELL_PX && yb < fh;
         for y in ya..yb {
             let Some(row) = frame.row(y) else { continue };
             let row = &row[..fw];
@@ -74,6 +76,13 @@ pub fn fill_cells(
             {
                 let xa = x0 + cx * CELL_PX;
                 let xb = (xa + CELL_PX).min(x0 + w);
+                if block_rows && xa >= 1 && xb == xa + CELL_PX && xb < fw {
+                    // The whole cell on its first row (the sums start at 0).
+                    if y == ya {
+                        (*s, *st, *sat) = full_block(frame, xa, ya);
+                    }
+                    continue;
+                }
                 // An inner cell (a pixel on each side, both neighbouring rows): the same
                 // sums and steps from slices, without a bounds check per read.
                 if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
@@ -208,6 +217,62 @@ fn full_inner_cell(
         let h = clamped[i].abs_diff(clamped[i + 2]);
         let vert = up[i].min(max_dn).abs_diff(down[i].min(max_dn));
         best = best.max(h).max(vert);
+    }
+    (acc, best, n_sat)
+}
+
+/// The sum, largest two-pixel step and saturated count of the whole 8×8 cell at
+/// `(xa, ya)` with a frame pixel on every side (`xa, ya ≥ 1`, `xa + 8 < width`,
+/// `ya + 8 < height`): [`full_inner_cell`] on its 8 rows, but first without the clamps
+/// to the top DN, which change nothing when no pixel read is above it (the bitwise or
+/// of them all at most the top DN, `2^bits − 1`): a pixel above it sends the cell
+/// through the clamped rows (never in a camera's frame; tested). `(0, 0, 0)` for a
+/// cell without its rows (never, by the caller's test).
+#[inline(always)]
+fn full_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
+    let max_dn = frame.max_dn();
+    const EMPTY: &[u16; CELL_PX + 2] = &[0; CELL_PX + 2];
+    let mut rows = [EMPTY; CELL_PX + 2];
+    // Rows ya − 1 ..= ya + 8, columns xa − 1 ..= xa + 8 (views of the frame).
+    for (k, out) in rows.iter_mut().enumerate() {
+        let Some(r) = frame
+            .row(ya + k - 1)
+            .and_then(|r| r.get(xa - 1..xa + CELL_PX + 1))
+            .and_then(|r| <&[u16; CELL_PX + 2]>::try_from(r).ok())
+        else {
+            return (0, 0, 0);
+        };
+        *out = r;
+    }
+    let mut any = 0u16;
+    for r in rows {
+        for &v in r {
+            any |= v;
+        }
+    }
+    let mut acc = 0u32;
+    let mut best = 0u16;
+    let mut n_sat = 0u8;
+    if any <= max_dn {
+        for k in 1..=CELL_PX {
+            let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
+            for i in 1..=CELL_PX {
+                let v = mid[i];
+                n_sat += u8::from(v >= max_dn);
+                acc += u32::from(v);
+                best = best
+                    .max(mid[i - 1].abs_diff(mid[i + 1]))
+                    .max(up[i].abs_diff(down[i]));
+            }
+        }
+    } else {
+        for k in 1..=CELL_PX {
+            let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
+            let (a, b, n) = full_inner_cell(mid, &up[..], &down[..], 1, max_dn, best);
+            acc += a;
+            best = b;
+            n_sat += n;
+        }
     }
     (acc, best, n_sat)
 }
@@ -409,18 +474,31 @@ mod tests {
     #[test]
     fn cell_plane_equals_brute_force() {
         let mut seed = 0x2545_F491u32;
-        for (w, h, bits) in [
-            (37usize, 29usize, 12u8),
-            (328, 248, 14),
-            (9, 1, 14),
-            (1, 9, 8),
+        // (width, height, bits, one pixel in `sparse` above the top DN; 0: values
+        // anywhere in 0..20 000): whole cells without a pixel above the top DN take
+        // the unclamped block path, the others the clamped rows.
+        for (w, h, bits, sparse) in [
+            (37usize, 29usize, 12u8, 0u32),
+            (328, 248, 14, 0),
+            (328, 248, 14, 700),
+            (328, 248, 16, 0),
+            (9, 1, 14, 0),
+            (1, 9, 8, 0),
         ] {
+            let top = (1u32 << bits) - 1;
             let px: Vec<u16> = (0..w * h)
                 .map(|_| {
                     seed ^= seed << 13;
                     seed ^= seed >> 17;
                     seed ^= seed << 5;
-                    (seed % 20_000) as u16
+                    if sparse == 0 {
+                        (seed % 20_000) as u16
+                    } else if seed % sparse == 0 {
+                        (top + 1 + seed % 100) as u16
+                    } else {
+                        // Near the top too: saturated pixels counted on both paths.
+                        (top - seed % 2_000) as u16
+                    }
                 })
                 .collect();
             let frame = Frame::new(&px, w, h, bits).unwrap();

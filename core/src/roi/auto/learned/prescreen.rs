@@ -24,6 +24,7 @@
 //! the forest is retrained).
 
 use super::features::{FEATURES, FrameLevels, RADII_CELLS, log_code};
+use super::narrow::{div_i64, div_u64};
 
 /// A cell whose largest two-pixel step reaches this [`log_code`] (of 4 · step / σ;
 /// feature 3) is a seed. 90: a step of about 13 σ (`log_code(52) = 90`); a noise
@@ -62,7 +63,7 @@ pub fn is_seed(
     let m = u64::from(mean_dn.get(i).copied().unwrap_or(0));
     // Feature 0's magnitude (the same arithmetic as `cell_features`).
     let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(lv.sigma.max(1)));
-    let level = ((m as i64 - i64::from(lv.p50)) * 256 / range).clamp(-4096, 4096);
+    let level = div_i64((m as i64 - i64::from(lv.p50)) * 256, range).clamp(-4096, 4096);
     if level.abs() >= i64::from(SEED_LEVEL_MIN) {
         return true;
     }
@@ -81,8 +82,8 @@ pub fn is_seed(
         let (xa, ya) = (x0.checked_sub(1), y0.checked_sub(1));
         let s = (at(Some(x1), Some(y1)) + at(xa, ya))
             .saturating_sub(at(xa, Some(y1)) + at(Some(x1), ya));
-        let mean = s / n.max(1);
-        let q = (m.abs_diff(mean) * 4 / sigma).min(u64::from(u32::MAX)) as u32;
+        let mean = div_u64(s, n.max(1));
+        let q = div_u64(m.abs_diff(mean) * 4, sigma).min(u64::from(u32::MAX)) as u32;
         if log_code(q) >= SEED_CONTRAST_CODE_MIN {
             return true;
         }
