@@ -38,7 +38,6 @@ pub fn fill_cells(
     sums: &mut [u32],
     steps: &mut [u16],
 ) {
-    let max_dn = frame.max_dn();
     let (pw, ph) = cell_plane(win);
     // The caller's rows hold a plane row of any window of the frame (`get_mut`: no
     // panic path, nothing filled if they were short).
@@ -61,13 +60,11 @@ pub fn fill_cells(
             .get_mut(cy * pw..(cy + 1) * pw)
             .unwrap_or_default();
         sat_row.fill(0);
-        // Whole cells with a frame row above and below: a block at a time.
+        // Whole cells with a frame row above and below: a block at a time, cell by
+        // cell (a loop over the rows for the cells at the window's sides); other cell
+        // rows row by row.
         let block_rows = ya >= 1 && yb == ya + CELL_PX && yb < fh;
-        for y in ya..yb {
-            let Some(row) = frame.row(y) else { continue };
-            let row = &row[..fw];
-            let up = frame.row(y.saturating_sub(1)).map(|r| &r[..fw]);
-            let down = frame.row((y + 1).min(fh - 1)).map(|r| &r[..fw]);
+        if block_rows {
             for (cx, ((s, st), sat)) in sums
                 .iter_mut()
                 .zip(step_row.iter_mut())
@@ -76,47 +73,28 @@ pub fn fill_cells(
             {
                 let xa = x0 + cx * CELL_PX;
                 let xb = (xa + CELL_PX).min(x0 + w);
-                if block_rows && xa >= 1 && xb == xa + CELL_PX && xb < fw {
-                    // The whole cell on its first row (the sums start at 0).
-                    if y == ya {
-                        (*s, *st, *sat) = full_block(frame, xa, ya);
+                if xa >= 1 && xb == xa + CELL_PX && xb < fw {
+                    (*s, *st, *sat) = full_block(frame, xa, ya);
+                } else {
+                    for y in ya..yb {
+                        let acc = cell_row(frame, y, xa, xb, *st);
+                        (*s, *st, *sat) = (*s + acc.0, acc.1, sat.saturating_add(acc.2));
                     }
-                    continue;
                 }
-                // An inner cell (a pixel on each side, both neighbouring rows): the same
-                // sums and steps from slices, without a bounds check per read.
-                if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
-                    let (acc, best, n_sat) = if xb - xa == CELL_PX {
-                        full_inner_cell(row, u, d, xa, max_dn, *st)
-                    } else {
-                        inner_cell(row, u, d, xa, xb, max_dn, *st)
-                    };
-                    *s += acc;
-                    *st = best;
-                    *sat = sat.saturating_add(n_sat);
-                    continue;
+            }
+        } else {
+            for y in ya..yb {
+                for (cx, ((s, st), sat)) in sums
+                    .iter_mut()
+                    .zip(step_row.iter_mut())
+                    .zip(sat_row.iter_mut())
+                    .enumerate()
+                {
+                    let xa = x0 + cx * CELL_PX;
+                    let xb = (xa + CELL_PX).min(x0 + w);
+                    let acc = cell_row(frame, y, xa, xb, *st);
+                    (*s, *st, *sat) = (*s + acc.0, acc.1, sat.saturating_add(acc.2));
                 }
-                let mut acc = 0u32;
-                let mut best = *st;
-                let mut n_sat = 0u8;
-                // Inside the frame (a window always is; `min(fw)` says so to the
-                // compiler: no bounds check per read below).
-                for x in xa..xb.min(fw) {
-                    n_sat += u8::from(row[x] >= max_dn);
-                    let v = row[x].min(max_dn);
-                    acc += u32::from(v);
-                    let l = row[x.saturating_sub(1)].min(max_dn);
-                    let r = row[(x + 1).min(fw - 1)].min(max_dn);
-                    let h = l.abs_diff(r);
-                    let vert = match (up, down) {
-                        (Some(u), Some(d)) => u[x].min(max_dn).abs_diff(d[x].min(max_dn)),
-                        _ => 0,
-                    };
-                    best = best.max(h).max(vert);
-                }
-                *s += acc;
-                *st = best;
-                *sat = sat.saturating_add(n_sat);
             }
         }
         // `get_mut`: the planes hold pw·ph cells (the caller's slices), so the row is
@@ -145,6 +123,50 @@ pub fn fill_cells(
             *m = (s / (rows * cols).max(1)) as u16;
         }
     }
+}
+
+/// Columns `xa..xb` of frame row `y` (inside the frame): the sum of the pixels clamped
+/// to the top DN, the largest of `best` and their two-pixel steps across and down
+/// (neighbours clamped at the frame's edges), and how many are at or above the top DN.
+/// `(0, best, 0)` for a row outside the frame.
+#[inline(always)]
+fn cell_row(frame: &Frame<'_>, y: usize, xa: usize, xb: usize, best: u16) -> (u32, u16, u8) {
+    let max_dn = frame.max_dn();
+    let (fw, fh) = (frame.width(), frame.height());
+    let Some(row) = frame.row(y) else {
+        return (0, best, 0);
+    };
+    let row = &row[..fw];
+    let up = frame.row(y.saturating_sub(1)).map(|r| &r[..fw]);
+    let down = frame.row((y + 1).min(fh - 1)).map(|r| &r[..fw]);
+    // An inner cell (a pixel on each side, both neighbouring rows): the same sums and
+    // steps from slices, without a bounds check per read.
+    if let (Some(u), Some(d), true) = (up, down, xa >= 1 && xb < fw) {
+        return if xb - xa == CELL_PX {
+            full_inner_cell(row, u, d, xa, max_dn, best)
+        } else {
+            inner_cell(row, u, d, xa, xb, max_dn, best)
+        };
+    }
+    let mut acc = 0u32;
+    let mut best = best;
+    let mut n_sat = 0u8;
+    // Inside the frame (a window always is; `min(fw)` says so to the compiler: no
+    // bounds check per read below).
+    for x in xa..xb.min(fw) {
+        n_sat += u8::from(row[x] >= max_dn);
+        let v = row[x].min(max_dn);
+        acc += u32::from(v);
+        let l = row[x.saturating_sub(1)].min(max_dn);
+        let r = row[(x + 1).min(fw - 1)].min(max_dn);
+        let h = l.abs_diff(r);
+        let vert = match (up, down) {
+            (Some(u), Some(d)) => u[x].min(max_dn).abs_diff(d[x].min(max_dn)),
+            _ => 0,
+        };
+        best = best.max(h).max(vert);
+    }
+    (acc, best, n_sat)
 }
 
 /// The sum of pixels `xa..xb` of `row` (clamped to `max_dn`), the largest of `best`
