@@ -256,16 +256,30 @@ impl<const T: usize, const L: usize> FlatForest<T, L> {
     pub fn score_reaching(&self, f: &[i32; FEATURES], floor: i32) -> Option<i32> {
         let slots = Self::slots(f);
         let mut s = self.bias;
-        for ((split, leaf), &rest) in self.split.iter().zip(&self.leaf).zip(&self.rest_max) {
-            // Wrapping: `build` proves no sum leaves the i32 range, so these are exact.
-            s = s.wrapping_add(Self::leaf_of(split, leaf, &slots));
-            if s.wrapping_add(rest) < floor {
+        // The bound is checked after every CHECK_TREES trees (and after the last).
+        let chunks = self
+            .split
+            .chunks(CHECK_TREES)
+            .zip(self.leaf.chunks(CHECK_TREES))
+            .zip(self.rest_max.chunks(CHECK_TREES));
+        for ((splits, leaves), rests) in chunks {
+            for (split, leaf) in splits.iter().zip(leaves) {
+                // Wrapping: `build` proves no sum leaves the i32 range, so this is exact.
+                s = s.wrapping_add(Self::leaf_of(split, leaf, &slots));
+            }
+            if s.wrapping_add(rests.last().copied().unwrap_or(0)) < floor {
                 return None;
             }
         }
         (s >= floor).then_some(s)
     }
 }
+
+/// Trees between two checks of [`FlatForest::score_reaching`]'s bound: a check costs a
+/// few instructions per tree, a late stop a tree's walk. Measured (`auto-v2` on the
+/// flight demo's frames, M7 mean): every tree 8.17 M, 2 trees 7.96 M, **4 trees
+/// 7.96 M** (x86-64 2 % fewer than 2), 8 trees 8.05 M.
+const CHECK_TREES: usize = 4;
 
 /// One split of [`FlatForest`]: a feature at most `threshold` goes left.
 #[derive(Debug, Clone, Copy)]
