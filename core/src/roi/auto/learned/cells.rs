@@ -46,7 +46,6 @@ pub fn fill_cells(
     };
     let (x0, w) = (win.x0, win.w);
     let fw = frame.width();
-    let fh = frame.height();
     for cy in 0..ph {
         let ya = win.y0 + cy * CELL_PX;
         let yb = (ya + CELL_PX).min(win.y0 + win.h);
@@ -60,10 +59,10 @@ pub fn fill_cells(
             .get_mut(cy * pw..(cy + 1) * pw)
             .unwrap_or_default();
         sat_row.fill(0);
-        // Whole cells with a frame row above and below: a block at a time, cell by
-        // cell (a loop over the rows for the cells at the window's sides); other cell
-        // rows row by row.
-        let block_rows = ya >= 1 && yb == ya + CELL_PX && yb < fh;
+        // Whole cells a block at a time, cell by cell (a loop over the rows for the
+        // cells at the frame's left and right edges); a cell row cut by the window's
+        // bottom row by row.
+        let block_rows = yb == ya + CELL_PX;
         if block_rows {
             for (cx, ((s, st), sat)) in sums
                 .iter_mut()
@@ -244,8 +243,9 @@ fn full_inner_cell(
 }
 
 /// The sum, largest two-pixel step and saturated count of the whole 8×8 cell at
-/// `(xa, ya)` with a frame pixel on every side (`xa, ya ≥ 1`, `xa + 8 < width`,
-/// `ya + 8 < height`): [`full_inner_cell`] on its 8 rows, but first without the clamps
+/// `(xa, ya)` with a frame pixel on its left and right (`xa ≥ 1`, `xa + 8 < width`,
+/// `ya + 8 ≤ height`; the frame's first and last rows are their own neighbours above
+/// and below, as in [`cell_row`]): [`full_inner_cell`] on its 8 rows, but first without the clamps
 /// to the top DN, which change nothing when no pixel read is above it (the bitwise or
 /// of them all at most the top DN, `2^bits − 1`): a pixel above it sends the cell
 /// through the clamped rows (never in a camera's frame; tested). `(0, 0, 0)` for a
@@ -256,9 +256,11 @@ fn full_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
     const EMPTY: &[u16; CELL_PX + 2] = &[0; CELL_PX + 2];
     let mut rows = [EMPTY; CELL_PX + 2];
     // Rows ya − 1 ..= ya + 8, columns xa − 1 ..= xa + 8 (views of the frame).
+    let last = frame.height().saturating_sub(1);
     for (k, out) in rows.iter_mut().enumerate() {
+        // The frame's first and last rows are their own neighbours (as in `cell_row`).
         let Some(r) = frame
-            .row(ya + k - 1)
+            .row((ya + k).saturating_sub(1).min(last))
             .and_then(|r| r.get(xa - 1..xa + CELL_PX + 1))
             .and_then(|r| <&[u16; CELL_PX + 2]>::try_from(r).ok())
         else {
@@ -525,51 +527,64 @@ mod tests {
                 })
                 .collect();
             let frame = Frame::new(&px, w, h, bits).unwrap();
-            let win = Window::full(&frame);
-            let (pw, ph) = cell_plane(win);
-            let sigma = 7u32;
-            let (mut mean, mut code) = (std::vec![0u16; pw * ph], std::vec![0u8; pw * ph]);
-            let mut sat = std::vec![0xAAu8; pw * ph];
-            let (mut sums, mut steps) = (std::vec![0u32; pw], std::vec![0u16; pw]);
-            fill_cells(
-                &frame,
-                win,
-                sigma,
-                CellPlanes {
-                    mean_dn: &mut mean,
-                    step_code: &mut code,
-                    saturated_px: &mut sat,
-                },
-                &mut sums,
-                &mut steps,
-            );
-            let top = frame.max_dn();
-            let at = |x: usize, y: usize| px[y * w + x].min(top);
-            for cy in 0..ph {
-                for cx in 0..pw {
-                    let (mut s, mut n, mut best, mut n_sat) = (0u64, 0u64, 0u16, 0u8);
-                    for y in cy * 8..(cy * 8 + 8).min(h) {
-                        for x in cx * 8..(cx * 8 + 8).min(w) {
-                            s += u64::from(at(x, y));
-                            n += 1;
-                            n_sat += u8::from(px[y * w + x] >= top);
-                            let across =
-                                at(x.saturating_sub(1), y).abs_diff(at((x + 1).min(w - 1), y));
-                            let down =
-                                at(x, y.saturating_sub(1)).abs_diff(at(x, (y + 1).min(h - 1)));
-                            best = best.max(across).max(down);
-                        }
+            // The whole frame, and a tracking window inside it (neighbours still read
+            // from the frame: only its own edges clamp).
+            let inner = Window::clipped(&frame, w / 5, h / 7, w - w / 6, h - h / 9);
+            for win in [Some(Window::full(&frame)), inner].into_iter().flatten() {
+                check_cell_plane(&frame, &px, win);
+            }
+        }
+    }
+
+    /// [`fill_cells`] of `win` against the brute force over `px` (the frame's pixels).
+    fn check_cell_plane(frame: &Frame<'_>, px: &[u16], win: Window) {
+        let (w, h) = (frame.width(), frame.height());
+        let (pw, ph) = cell_plane(win);
+        let sigma = 7u32;
+        let (mut mean, mut code) = (std::vec![0u16; pw * ph], std::vec![0u8; pw * ph]);
+        let mut sat = std::vec![0xAAu8; pw * ph];
+        let (mut sums, mut steps) = (std::vec![0u32; pw], std::vec![0u16; pw]);
+        fill_cells(
+            frame,
+            win,
+            sigma,
+            CellPlanes {
+                mean_dn: &mut mean,
+                step_code: &mut code,
+                saturated_px: &mut sat,
+            },
+            &mut sums,
+            &mut steps,
+        );
+        let top = frame.max_dn();
+        let at = |x: usize, y: usize| px[y * w + x].min(top);
+        for cy in 0..ph {
+            for cx in 0..pw {
+                let (mut s, mut n, mut best, mut n_sat) = (0u64, 0u64, 0u16, 0u8);
+                let (xa, ya) = (win.x0 + cx * 8, win.y0 + cy * 8);
+                for y in ya..(ya + 8).min(win.y0 + win.h) {
+                    for x in xa..(xa + 8).min(win.x0 + win.w) {
+                        s += u64::from(at(x, y));
+                        n += 1;
+                        n_sat += u8::from(px[y * w + x] >= top);
+                        let across = at(x.saturating_sub(1), y).abs_diff(at((x + 1).min(w - 1), y));
+                        let down = at(x, y.saturating_sub(1)).abs_diff(at(x, (y + 1).min(h - 1)));
+                        best = best.max(across).max(down);
                     }
-                    let i = cy * pw + cx;
-                    assert_eq!(u64::from(mean[i]), s / n, "{w}x{h} cell ({cx}, {cy})");
-                    assert_eq!(sat[i], n_sat, "{w}x{h} saturated ({cx}, {cy})");
-                    let want = super::super::features::log_code(u32::from(best) * 4 / sigma);
-                    assert_eq!(
-                        i32::from(code[i]),
-                        want.clamp(0, 255),
-                        "{w}x{h} ({cx}, {cy})"
-                    );
                 }
+                let i = cy * pw + cx;
+                assert_eq!(
+                    u64::from(mean[i]),
+                    s / n,
+                    "{w}x{h} {win:?} cell ({cx}, {cy})"
+                );
+                assert_eq!(sat[i], n_sat, "{w}x{h} {win:?} saturated ({cx}, {cy})");
+                let want = super::super::features::log_code(u32::from(best) * 4 / sigma);
+                assert_eq!(
+                    i32::from(code[i]),
+                    want.clamp(0, 255),
+                    "{w}x{h} {win:?} ({cx}, {cy})"
+                );
             }
         }
     }
