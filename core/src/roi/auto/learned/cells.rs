@@ -59,9 +59,9 @@ pub fn fill_cells(
             .get_mut(cy * pw..(cy + 1) * pw)
             .unwrap_or_default();
         sat_row.fill(0);
-        // Whole cells a block at a time, cell by cell (a loop over the rows for the
-        // cells at the frame's left and right edges); a cell row cut by the window's
-        // bottom row by row.
+        // Whole cells a block at a time, cell by cell (those at the frame's left and
+        // right edges from a copy); a cell cut by the window's right side, and a cell
+        // row cut by its bottom, row by row.
         let block_rows = yb == ya + CELL_PX;
         if block_rows {
             for (cx, ((s, st), sat)) in sums
@@ -74,6 +74,8 @@ pub fn fill_cells(
                 let xb = (xa + CELL_PX).min(x0 + w);
                 if xa >= 1 && xb == xa + CELL_PX && xb < fw {
                     (*s, *st, *sat) = full_block(frame, xa, ya);
+                } else if xb == xa + CELL_PX {
+                    (*s, *st, *sat) = edge_block(frame, xa, ya);
                 } else {
                     for y in ya..yb {
                         let acc = cell_row(frame, y, xa, xb, *st);
@@ -252,7 +254,6 @@ fn full_inner_cell(
 /// cell without its rows (never, by the caller's test).
 #[inline(always)]
 fn full_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
-    let max_dn = frame.max_dn();
     const EMPTY: &[u16; CELL_PX + 2] = &[0; CELL_PX + 2];
     let mut rows = [EMPTY; CELL_PX + 2];
     // Rows ya − 1 ..= ya + 8, columns xa − 1 ..= xa + 8 (views of the frame).
@@ -268,6 +269,39 @@ fn full_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
         };
         *out = r;
     }
+    block_of(rows, frame.max_dn())
+}
+
+/// [`full_block`] of a whole cell on the frame's left or right edge (`xa + 8 ≤ width`),
+/// whose outer column is its own neighbour (as in [`cell_row`]): the 10 × 10 pixels
+/// copied with the edge column repeated.
+#[inline(never)]
+fn edge_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
+    let (last_x, last_y) = (
+        frame.width().saturating_sub(1),
+        frame.height().saturating_sub(1),
+    );
+    let mut copies = [[0u16; CELL_PX + 2]; CELL_PX + 2];
+    for (k, out) in copies.iter_mut().enumerate() {
+        let Some(r) = frame.row((ya + k).saturating_sub(1).min(last_y)) else {
+            return (0, 0, 0);
+        };
+        for (j, v) in out.iter_mut().enumerate() {
+            *v = r
+                .get((xa + j).saturating_sub(1).min(last_x))
+                .copied()
+                .unwrap_or(0);
+        }
+    }
+    block_of(copies.each_ref(), frame.max_dn())
+}
+
+/// The sum, largest two-pixel step and saturated count of the 8 × 8 pixels inside
+/// `rows` (10 rows of 10: the cell and a neighbour on every side), first without the
+/// clamps to the top DN `max_dn`, which change nothing when no pixel is above it (the
+/// bitwise or of them all at most `2^bits − 1`), else through the clamped rows.
+#[inline(always)]
+fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
     let mut any = 0u16;
     for r in rows {
         for &v in r {
