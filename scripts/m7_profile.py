@@ -13,7 +13,8 @@ import sys
 
 # The first match along a block's inline chain (innermost first) names its stage.
 STAGES = [
-    ("full_block", "cell plane"), ("fill_cells", "cell plane"),
+    ("full_block", "cell plane"), ("edge_block", "cell plane"), ("block_of", "cell plane"),
+    ("fill_cells", "cell plane"),
     ("full_inner_cell", "cell plane"), ("cell_row", "cell plane"),
     ("score_reaching", "forest"), ("leaf_of", "forest"),
     ("sub_window_extremes", "4x4 windows"), ("cell_features", "cell features"),
