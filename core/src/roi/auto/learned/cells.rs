@@ -59,40 +59,25 @@ pub fn fill_cells(
             .get_mut(cy * pw..(cy + 1) * pw)
             .unwrap_or_default();
         sat_row.fill(0);
-        // Whole cells a block at a time, cell by cell (those at the frame's left and
-        // right edges from a copy); a cell cut by the window's right side, and a cell
-        // row cut by its bottom, row by row.
-        let block_rows = yb == ya + CELL_PX;
-        if block_rows {
-            for (cx, ((s, st), sat)) in sums
-                .iter_mut()
-                .zip(step_row.iter_mut())
-                .zip(sat_row.iter_mut())
-                .enumerate()
-            {
-                let xa = x0 + cx * CELL_PX;
-                let xb = (xa + CELL_PX).min(x0 + w);
-                if xa >= 1 && xb == xa + CELL_PX && xb < fw {
-                    (*s, *st, *sat) = full_block(frame, xa, ya);
-                } else if xb == xa + CELL_PX {
-                    (*s, *st, *sat) = edge_block(frame, xa, ya);
+        // Cell by cell: a whole cell as a block (those at the frame's left and right
+        // edges from a copy); a cell cut by the window's right side or bottom row by
+        // row.
+        for (cx, ((s, st), sat)) in sums
+            .iter_mut()
+            .zip(step_row.iter_mut())
+            .zip(sat_row.iter_mut())
+            .enumerate()
+        {
+            let xa = x0 + cx * CELL_PX;
+            let xb = (xa + CELL_PX).min(x0 + w);
+            if yb == ya + CELL_PX && xb == xa + CELL_PX {
+                (*s, *st, *sat) = if xa >= 1 && xb < fw {
+                    full_block(frame, xa, ya)
                 } else {
-                    for y in ya..yb {
-                        let acc = cell_row(frame, y, xa, xb, *st);
-                        (*s, *st, *sat) = (*s + acc.0, acc.1, sat.saturating_add(acc.2));
-                    }
-                }
-            }
-        } else {
-            for y in ya..yb {
-                for (cx, ((s, st), sat)) in sums
-                    .iter_mut()
-                    .zip(step_row.iter_mut())
-                    .zip(sat_row.iter_mut())
-                    .enumerate()
-                {
-                    let xa = x0 + cx * CELL_PX;
-                    let xb = (xa + CELL_PX).min(x0 + w);
+                    edge_block(frame, xa, ya)
+                };
+            } else {
+                for y in ya..yb {
                     let acc = cell_row(frame, y, xa, xb, *st);
                     (*s, *st, *sat) = (*s + acc.0, acc.1, sat.saturating_add(acc.2));
                 }
@@ -462,7 +447,7 @@ mod tests {
     /// cells on every side) and values above the top DN.
     #[test]
     fn sub_window_extremes_equal_brute_force() {
-        let mut seed = 0x9E37_79B9u32;
+        let mut rand = super::super::xorshift32(0x9E37_79B9);
         let mut windows = 0u32;
         for (w, h, bits, win) in [
             (37usize, 29usize, 12u8, None),
@@ -470,14 +455,7 @@ mod tests {
             (61, 45, 14, Some((5usize, 3usize, 50usize, 39usize))),
             (9, 3, 8, None),
         ] {
-            let px: Vec<u16> = (0..w * h)
-                .map(|_| {
-                    seed ^= seed << 13;
-                    seed ^= seed >> 17;
-                    seed ^= seed << 5;
-                    (seed % 20_000) as u16
-                })
-                .collect();
+            let px: Vec<u16> = (0..w * h).map(|_| (rand() % 20_000) as u16).collect();
             let frame = Frame::new(&px, w, h, bits).unwrap();
             let win = match win {
                 None => Window::full(&frame),
@@ -532,7 +510,7 @@ mod tests {
     /// bit depth's top DN, and the full reference size.
     #[test]
     fn cell_plane_equals_brute_force() {
-        let mut seed = 0x2545_F491u32;
+        let mut rand = super::super::xorshift32(0x2545_F491);
         // (width, height, bits, one pixel in `sparse` above the top DN; 0: values
         // anywhere in 0..20 000): whole cells without a pixel above the top DN take
         // the unclamped block path, the others the clamped rows.
@@ -547,9 +525,7 @@ mod tests {
             let top = (1u32 << bits) - 1;
             let px: Vec<u16> = (0..w * h)
                 .map(|_| {
-                    seed ^= seed << 13;
-                    seed ^= seed >> 17;
-                    seed ^= seed << 5;
+                    let seed = rand();
                     if sparse == 0 {
                         (seed % 20_000) as u16
                     } else if seed % sparse == 0 {
