@@ -376,13 +376,7 @@ mod tests {
         };
         const { assert!(FLIGHT_DEPTH >= 1 && FLIGHT_DEPTH <= 7) };
         let mut checked = 0u32;
-        let mut s = 0x9E37_79B9u32;
-        let mut rand = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s
-        };
+        let mut rand = super::super::xorshift32(0x9E37_79B9);
         for n in forest_trees::NODES.iter().filter(|n| n.feature != LEAF) {
             for v in [n.threshold, n.threshold.saturating_add(1)] {
                 // The split's feature at the threshold or just above; the others random.
@@ -412,13 +406,7 @@ mod tests {
     /// (the bound is not vacuous: a cell far below the floor).
     #[test]
     fn score_reaching_is_the_score_above_the_floor() {
-        let mut s = 0x1234_5678u32;
-        let mut rand = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s
-        };
+        let mut rand = super::super::xorshift32(0x1234_5678);
         let mut below = 0u32;
         for _ in 0..5_000 {
             let mut f = [0i32; FEATURES];

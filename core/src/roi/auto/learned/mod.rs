@@ -1503,6 +1503,18 @@ impl Detector for AutoV2 {
         Ok(self.run(frame, &mut scratch.work))
     }
 }
+/// A xorshift32 stream from `seed` (≠ 0): the tests' deterministic pseudo-random numbers.
+#[cfg(test)]
+pub(crate) fn xorshift32(seed: u32) -> impl FnMut() -> u32 {
+    let mut s = seed;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 17;
+        s ^= s << 5;
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::features::{FEATURES, log_code};

@@ -36,6 +36,7 @@
 
 use super::features::FrameLevels;
 use super::forest::{self, Node};
+use super::narrow::isqrt_u64;
 use super::spot_trees;
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -265,7 +266,7 @@ fn spot_of(
     }
     let z2 = (256 * a2).checked_div(81 * den).unwrap_or(0);
     // A 32-bit square root where it fits (z < 4096: every spot of a real frame).
-    let z16 = u32::try_from(z2).map_or_else(|_| z2.isqrt(), |v| u64::from(v.isqrt()));
+    let z16 = isqrt_u64(z2);
     Some(Spot {
         x: u16::try_from(x).ok()?,
         y: u16::try_from(y).ok()?,
