@@ -54,7 +54,8 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
-        any::<bool>(),
+        // (spot, link_cells): proptest's tuples end at 12.
+        (any::<bool>(), prop_oneof![Just(2u8), 1u8..=3]),
     )
         .prop_map(
             |(
@@ -69,7 +70,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
-                spot,
+                (spot, link_cells),
             )| {
                 AutoV2 {
                     prior,
@@ -84,6 +85,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     small_target,
                     candidates,
                     spot,
+                    link_cells,
                 }
             },
         )
@@ -320,7 +322,7 @@ proptest! {
     /// Parameters out of bounds: an error naming the field, never a panic, on any frame.
     #[test]
     fn parameters_out_of_bounds_are_errors(
-        which in 0u8..6,
+        which in 0u8..8,
         seed in any::<u64>(),
     ) {
         let img = frame(seed, 64, 48, 14);
@@ -330,6 +332,8 @@ proptest! {
             2 => AutoV2 { min_score_permille: 1001, ..AutoV2::default() },
             3 => AutoV2 { candidates: 0, ..AutoV2::default() },
             4 => AutoV2 { candidates: 5, ..AutoV2::default() },
+            5 => AutoV2 { link_cells: 0, ..AutoV2::default() },
+            6 => AutoV2 { link_cells: 4, ..AutoV2::default() },
             _ => AutoV2 { saturated_erode_px: 9, ..AutoV2::default() },
         };
         let got = bad.detect(&img.frame(), &mut Box::new(AutoV2Scratch::new()));

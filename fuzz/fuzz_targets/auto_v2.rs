@@ -88,6 +88,8 @@ fuzz_target!(|data: &[u8]| {
         },
         candidates: 1 + ((data[2] >> 4) & 3),
         spot: data[3] & 0x01 == 0,
+        // 1..=3 (the width's byte's top bits: every value is also a width).
+        link_cells: 1 + (data[0] >> 6) % 3,
     };
     let dn: Vec<u16> = data[dn_from..]
         .chunks_exact(2)

@@ -24,7 +24,8 @@
 //! training data; run the confidence model's `predict-all` with `off`: its winner
 //! statistics are the classifier's) and the components stage 4b rates
 //! (`AutoV2::candidates`, 1..=4; the confidence model's training data is the strongest
-//! alone: 1). Every line ends with
+//! alone: 1) and stage 4's link between target cells (`AutoV2::link_cells`, 1..=3).
+//! Every line ends with
 //! the frame's largest saturated blob (`learned::blob::BlobStats`: saturated pixels,
 //! solidity ‰, ring depth ‰, others ‰, sides, its confidence ‰; empty without one),
 //! the blob model's training data (`scripts/train-auto.py --blob`).
@@ -101,6 +102,13 @@ fn main() {
         .get(12)
         .map(|v| v.parse::<u8>().expect("candidates: 1..=4"))
         .unwrap_or(AutoV2::default().candidates);
+    // Optional: stage 4's link between target cells, cells (default: `AutoV2::default()`'s).
+    let link_cells = args
+        .get(13)
+        .map(|v| v.parse::<u8>().expect("link_cells: 1..=3"))
+        .unwrap_or(AutoV2::default().link_cells);
+    // Optional (experiments): `noscreen` classifies every cell (`AutoV2::prescreen` off).
+    let prescreen = args.get(14).map(String::as_str) != Some("noscreen");
     let list = common::frames(&dir);
     let lines: Vec<String> = list
         .par_iter()
@@ -172,6 +180,8 @@ fn main() {
                     body,
                     blob,
                     candidates,
+                    link_cells,
+                    prescreen,
                     ..AutoV2::default()
                 };
                 let mut d = gate_off.detect(&frame, &mut scratch).expect("detect");
