@@ -544,6 +544,13 @@ pub const MAX_LINK_CELLS: usize = 3;
 /// joined, deterministically.
 const MAX_LINK_PASSES: usize = 4;
 
+/// Most target cells outside the winner stage 4c looks at per call (each looks at its
+/// ≤ (2 · [`MAX_LINK_CELLS`] + 1)² neighbours): the stage stops there, the winner partly
+/// joined, deterministically. A bound on the work, not a choice: on 3 220 frames of ten
+/// sets (family A and B, the test sets; the gate off, so on every winner) a call looked
+/// at 19 cells at most.
+const MAX_LINK_LOOKS: usize = 256;
+
 /// Whether target cells `a` and `b` (indices into the `pw`-wide plane of cell means
 /// `mean_dn`) are one body across the gap between them: the cell midway departs from
 /// the frame's level `level_dn` on the same side as both, by at least half the lesser
@@ -563,17 +570,44 @@ fn bridges_body(mean_dn: &[u16], pw: usize, level_dn: u16, a: usize, b: usize) -
 /// Stage 4c ([`AutoV2::link_cells`]): joins to the winner `root` (labels in `labels8`,
 /// `n8` cells of the `plane8` plane) every component with a cell within `reach` cells
 /// of one of the winner's that [`bridges_body`] links to it, sweeping the winner's
-/// cell box grown by `reach` until nothing joins ([`MAX_LINK_PASSES`] at most; each
-/// sweep at most the plane's cells × (2 · reach + 1)² neighbour looks). Returns the
+/// cell box grown by `reach` until nothing joins ([`MAX_LINK_PASSES`] at most) or
+/// [`MAX_LINK_LOOKS`] cells outside the winner were looked at. Returns the
 /// root and statistics of the joined winner, `None` when nothing joined (or `reach`
 /// ≤ 1).
 fn join_linked<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
     plane8: (usize, usize),
     n8: usize,
+    root: u8,
+    reach: usize,
+    level_dn: u16,
+) -> Option<(u8, CellStats)> {
+    join_linked_counted(work, plane8, n8, root, reach, level_dn).0
+}
+
+/// [`join_linked`] and the number of cells outside the winner it looked at.
+fn join_linked_counted<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane8: (usize, usize),
+    n8: usize,
     mut root: u8,
     reach: usize,
     level_dn: u16,
+) -> (Option<(u8, CellStats)>, usize) {
+    let mut looks = 0usize;
+    let joined = join_within(work, plane8, n8, &mut root, reach, level_dn, &mut looks);
+    (joined, looks)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn join_within<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane8: (usize, usize),
+    n8: usize,
+    root: &mut u8,
+    reach: usize,
+    level_dn: u16,
+    looks: &mut usize,
 ) -> Option<(u8, CellStats)> {
     let (pw, ph) = plane8;
     if reach <= 1 || pw == 0 {
@@ -584,12 +618,12 @@ fn join_linked<C: FrameCapacity>(
     let mean_dn = work.mean_dn.as_ref().get(..n8)?;
     let comps = &mut work.comps;
     let mut joined = false;
-    for _ in 0..MAX_LINK_PASSES {
+    'sweeps: for _ in 0..MAX_LINK_PASSES {
         let mut changed = false;
         // Only cells within `reach` of the winner's cell box can join it; the box is
         // read again on every row and after every join (a raster sweep carries a
         // chain rightwards and downwards in one pass, as over the whole plane).
-        let mut b = *comps.stats(usize::from(root))?;
+        let mut b = *comps.stats(usize::from(*root))?;
         let mut y = usize::from(b.y0).saturating_sub(reach);
         while y < (b.y_end() + reach).min(ph) {
             let mut x = usize::from(b.x0).saturating_sub(reach);
@@ -601,23 +635,29 @@ fn join_linked<C: FrameCapacity>(
                     continue;
                 }
                 let r = comps.find(l);
-                if r == root {
+                if r == *root {
                     continue;
                 }
+                // The bound on the work (see `MAX_LINK_LOOKS`).
+                if *looks == MAX_LINK_LOOKS {
+                    joined |= changed;
+                    break 'sweeps;
+                }
+                *looks += 1;
                 let (cx, cy) = (i % pw, i / pw);
                 let near = (cy.saturating_sub(reach)..(cy + reach + 1).min(ph)).any(|ny| {
                     (cx.saturating_sub(reach)..(cx + reach + 1).min(pw)).any(|nx| {
                         let j = ny * pw + nx;
                         labels.get(j).is_some_and(|&lj| {
                             lj != 0
-                                && comps.find(lj) == root
+                                && comps.find(lj) == *root
                                 && bridges_body(mean_dn, pw, level_dn, i, j)
                         })
                     })
                 });
                 if near {
-                    root = comps.union(root, r);
-                    b = *comps.stats(usize::from(root))?;
+                    *root = comps.union(*root, r);
+                    b = *comps.stats(usize::from(*root))?;
                     changed = true;
                 }
             }
@@ -631,7 +671,7 @@ fn join_linked<C: FrameCapacity>(
     if !joined {
         return None;
     }
-    Some((root, *comps.stats(usize::from(root))?))
+    Some((*root, *comps.stats(usize::from(*root))?))
 }
 
 /// Most components stage 4b rates ([`AutoV2::candidates`]): the model's cost per
@@ -2152,6 +2192,92 @@ mod tests {
         let (root, _, _) = strongest_component(&mut work, (pw, ph), CELL_RELABEL_CODES).unwrap();
         let (_, joined) = join_linked(&mut work, (pw, ph), n, root, 2, level).unwrap();
         assert_eq!((joined.x_last, joined.area), (17, 10), "{joined:?}");
+        // A body scattered over the whole plane (pairs of cells one cell apart on every
+        // other row: 224 components, 448 cells): the work bound stops the joining
+        // after MAX_LINK_LOOKS cells looked at, the same way every time.
+        let scattered = |work: &mut AutoV2Work| {
+            work.mean_dn.as_mut()[..n].fill(600);
+            work.labels4.as_mut()[..n].fill(0);
+            for y in (0..ph).step_by(2) {
+                for x in (0..pw).filter(|x| x % 3 != 2) {
+                    work.labels4.as_mut()[y * pw + x] = if (x, y) == (0, 0) { 200 } else { 20 };
+                }
+            }
+            let (root, _, _) = strongest_component(work, (pw, ph), CELL_RELABEL_CODES).unwrap();
+            join_linked(work, (pw, ph), n, root, 2, level).unwrap().1
+        };
+        let first = scattered(&mut work);
+        assert_eq!((first.x_last, first.y_last, first.area), (40, 30, 448));
+        let again = scattered(&mut work);
+        assert_eq!(
+            (first.x_last, first.y_last, first.area),
+            (again.x_last, again.y_last, again.area)
+        );
+    }
+
+    /// Stage 4c on random planes: never more than MAX_LINK_LOOKS cells looked at; every
+    /// joined cell outside the first winner lies within reach of another joined cell
+    /// that the bridge rule links it to (or in its own 8-connected component).
+    #[test]
+    fn linked_cells_on_random_planes_are_bounded_and_bridged() {
+        let (pw, ph) = (41usize, 31usize);
+        let n = pw * ph;
+        let mut next = xorshift32(0x51ed_0037);
+        let mut work: std::boxed::Box<AutoV2Work> = std::boxed::Box::new(ConstInit::INIT);
+        let mut most = 0;
+        for round in 0..300 {
+            let density = 5 + round % 40;
+            for i in 0..n {
+                work.mean_dn.as_mut()[i] = if next() % 100 < 50 {
+                    600
+                } else {
+                    1000 + (next() % 300) as u16
+                };
+                work.labels4.as_mut()[i] = if next() % 100 < density {
+                    1 + (next() % 60) as u8
+                } else {
+                    0
+                };
+            }
+            let Some((root, _, _)) = strongest_component(&mut work, (pw, ph), CELL_RELABEL_CODES)
+            else {
+                continue;
+            };
+            let first: std::vec::Vec<bool> = (0..n)
+                .map(|i| {
+                    let l = work.labels8.as_ref()[i];
+                    l != 0 && work.comps.find(l) == root
+                })
+                .collect();
+            let (got, looks) = join_linked_counted(&mut work, (pw, ph), n, root, 2, 1100);
+            assert!(looks <= MAX_LINK_LOOKS, "{looks}");
+            most = most.max(looks);
+            let Some((r, _)) = got else { continue };
+            let member: std::vec::Vec<bool> = (0..n)
+                .map(|i| {
+                    let l = work.labels8.as_ref()[i];
+                    l != 0 && work.comps.find(l) == r
+                })
+                .collect();
+            for i in (0..n).filter(|&i| member[i] && !first[i]) {
+                let (x, y) = (i % pw, i / pw);
+                let linked = (y.saturating_sub(2)..(y + 3).min(ph)).any(|ny| {
+                    (x.saturating_sub(2)..(x + 3).min(pw)).any(|nx| {
+                        let j = ny * pw + nx;
+                        j != i
+                            && member[j]
+                            && (x.abs_diff(nx) <= 1 && y.abs_diff(ny) <= 1
+                                || bridges_body(work.mean_dn.as_ref(), pw, 1100, i, j))
+                    })
+                });
+                assert!(
+                    linked,
+                    "round {round}: cell ({x}, {y}) joined without a link"
+                );
+            }
+        }
+        // The random planes reach the bound (it is exercised, not only proven).
+        assert_eq!(most, MAX_LINK_LOOKS);
     }
 
     /// The bridge rule against its definition: same side of the level as both ends,
