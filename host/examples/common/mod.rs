@@ -9,9 +9,9 @@ use tirroi_core::roi::Roi;
 /// target).
 pub type Entry = (String, u8, Option<Roi>);
 
-/// Every frame of `dir/metadata.jsonl`, in its order; a missing file or a line that is
-/// not JSON or has no `"file"` is one error line naming it, exit code 2.
-pub fn frames(dir: &Path) -> Vec<Entry> {
+/// Every record of `dir/metadata.jsonl`, in its order, as JSON values; a missing file
+/// or a line that is not JSON is one error line naming it, exit code 2.
+pub fn metadata(dir: &Path) -> Vec<serde_json::Value> {
     let path = dir.join("metadata.jsonl");
     let meta = std::fs::read_to_string(&path).unwrap_or_else(|e| {
         eprintln!("{}: {e}", path.display());
@@ -20,10 +20,22 @@ pub fn frames(dir: &Path) -> Vec<Entry> {
     meta.lines()
         .enumerate()
         .map(|(n, l)| {
-            let v: serde_json::Value = serde_json::from_str(l).unwrap_or_else(|e| {
+            serde_json::from_str(l).unwrap_or_else(|e| {
                 eprintln!("{}:{}: not JSON: {e}", path.display(), n + 1);
                 std::process::exit(2)
-            });
+            })
+        })
+        .collect()
+}
+
+/// Every frame of `dir/metadata.jsonl`, in its order ([`metadata`]); a record without
+/// a `"file"` is one error line naming it, exit code 2.
+pub fn frames(dir: &Path) -> Vec<Entry> {
+    let path = dir.join("metadata.jsonl");
+    metadata(dir)
+        .into_iter()
+        .enumerate()
+        .map(|(n, v)| {
             let bbox = v["bbox"].as_array().and_then(|b| {
                 let c: Vec<u16> = b
                     .iter()
