@@ -13,7 +13,8 @@
 //! `cargo run --release -p tirroi-host --example clutter_steps -- DIR [DIR ...]
 //! [--earth-min F] [--mode radiometry|detection]` prints one Markdown table per
 //! dataset (frames without a target; with `--earth-min`, only those whose metadata's
-//! `earth_fraction` reaches F; with `--mode`, only that readout mode).
+//! `earth_fraction` reaches F; with `--mode`, only that readout mode), and the median
+//! ratio of the detector's noise σ to the renderer's noise at the camera's NETD.
 mod common;
 
 use std::path::PathBuf;
@@ -74,7 +75,13 @@ fn main() {
             })
             .map(|(e, _)| e.clone())
             .collect();
-        let counts = kept
+        let netd_sigma: Vec<Option<f64>> = list
+            .iter()
+            .zip(&meta)
+            .filter(|((f, _, _), _)| kept.iter().any(|(k, _, _)| k == f))
+            .map(|(_, m)| m["noise_sigma_dn"].as_f64().filter(|&v| v > 0.0))
+            .collect();
+        let per_frame: Vec<_> = kept
             .par_iter()
             .map(|(file, bits, _)| {
                 let f = read_frame(&dir.join(file), Some(*bits)).unwrap_or_else(|e| {
@@ -84,7 +91,7 @@ fn main() {
                 let frame = f.view().expect("a frame within the capacity");
                 let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
                 let mut c = [[0u64; 2]; BIN_ENDS_SIGMA.len() + 1];
-                for_each_cell_features(&frame, &mut work, |_, _, feats| {
+                let sigma = for_each_cell_features(&frame, &mut work, |_, _, feats| {
                     let bin = ends
                         .iter()
                         .position(|&e| feats[STEP_FEATURE] < e)
@@ -92,18 +99,26 @@ fn main() {
                     c[bin][0] += 1;
                     c[bin][1] += u64::from(forest::FLIGHT.score(feats) >= floor);
                 });
-                c
+                (c, sigma)
             })
-            .reduce(
-                || [[0u64; 2]; BIN_ENDS_SIGMA.len() + 1],
-                |mut a, b| {
-                    for (x, y) in a.iter_mut().zip(b) {
-                        x[0] += y[0];
-                        x[1] += y[1];
-                    }
-                    a
-                },
-            );
+            .collect();
+        let mut counts = [[0u64; 2]; BIN_ENDS_SIGMA.len() + 1];
+        for (c, _) in &per_frame {
+            for (x, y) in counts.iter_mut().zip(c) {
+                x[0] += y[0];
+                x[1] += y[1];
+            }
+        }
+        // The detector's noise σ over the renderer's noise σ at the camera's NETD (the
+        // metadata's `noise_sigma_dn`): above 1 where the camera's signature or the
+        // scene's texture raise the estimate.
+        let mut ratios: Vec<f64> = per_frame
+            .iter()
+            .zip(&netd_sigma)
+            .filter_map(|((_, s), n)| n.map(|n| f64::from(*s) / n))
+            .collect();
+        ratios.sort_by(f64::total_cmp);
+        let median_ratio = ratios.get(ratios.len() / 2).copied();
         let cells: u64 = counts.iter().map(|c| c[0]).sum();
         let targets: u64 = counts.iter().map(|c| c[1]).sum();
         println!(
@@ -111,6 +126,9 @@ fn main() {
             dir.display(),
             kept.len()
         );
+        if let Some(r) = median_ratio {
+            println!("the detector's noise σ / the NETD noise σ: {r:.2} (median)\n");
+        }
         println!("| largest 2-px step | cells | of them scored as target |");
         println!("|---|---|---|");
         for (k, c) in counts.iter().enumerate() {
