@@ -588,34 +588,23 @@ fn join_linked<C: FrameCapacity>(
 /// [`join_linked`] and the number of cells outside the winner it looked at.
 fn join_linked_counted<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
-    plane8: (usize, usize),
+    (pw, ph): (usize, usize),
     n8: usize,
     mut root: u8,
     reach: usize,
     level_dn: u16,
 ) -> (Option<(u8, CellStats)>, usize) {
     let mut looks = 0usize;
-    let joined = join_within(work, plane8, n8, &mut root, reach, level_dn, &mut looks);
-    (joined, looks)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn join_within<C: FrameCapacity>(
-    work: &mut AutoV2Work<C>,
-    plane8: (usize, usize),
-    n8: usize,
-    root: &mut u8,
-    reach: usize,
-    level_dn: u16,
-    looks: &mut usize,
-) -> Option<(u8, CellStats)> {
-    let (pw, ph) = plane8;
+    let (Some(labels), Some(mean_dn)) = (
+        work.labels8.as_ref().get(..n8),
+        work.mean_dn.as_ref().get(..n8),
+    ) else {
+        return (None, looks);
+    };
     if reach <= 1 || pw == 0 {
-        return None;
+        return (None, looks);
     }
     let reach = reach.min(MAX_LINK_CELLS);
-    let labels = work.labels8.as_ref().get(..n8)?;
-    let mean_dn = work.mean_dn.as_ref().get(..n8)?;
     let comps = &mut work.comps;
     let mut joined = false;
     'sweeps: for _ in 0..MAX_LINK_PASSES {
@@ -623,55 +612,58 @@ fn join_within<C: FrameCapacity>(
         // Only cells within `reach` of the winner's cell box can join it; the box is
         // read again on every row and after every join (a raster sweep carries a
         // chain rightwards and downwards in one pass, as over the whole plane).
-        let mut b = *comps.stats(usize::from(*root))?;
+        let Some(&first) = comps.stats(usize::from(root)) else {
+            break;
+        };
+        let mut b = first;
         let mut y = usize::from(b.y0).saturating_sub(reach);
         while y < (b.y_end() + reach).min(ph) {
             let mut x = usize::from(b.x0).saturating_sub(reach);
             while x < (b.x_end() + reach).min(pw) {
-                let i = y * pw + x;
+                let (cx, cy, i) = (x, y, y * pw + x);
                 x += 1;
-                let Some(&l) = labels.get(i) else { continue };
+                let l = labels.get(i).copied().unwrap_or(0);
                 if l == 0 {
                     continue;
                 }
                 let r = comps.find(l);
-                if r == *root {
+                if r == root {
                     continue;
                 }
                 // The bound on the work (see `MAX_LINK_LOOKS`).
-                if *looks == MAX_LINK_LOOKS {
-                    joined |= changed;
+                if looks == MAX_LINK_LOOKS {
                     break 'sweeps;
                 }
-                *looks += 1;
-                let (cx, cy) = (i % pw, i / pw);
+                looks += 1;
                 let near = (cy.saturating_sub(reach)..(cy + reach + 1).min(ph)).any(|ny| {
                     (cx.saturating_sub(reach)..(cx + reach + 1).min(pw)).any(|nx| {
                         let j = ny * pw + nx;
                         labels.get(j).is_some_and(|&lj| {
                             lj != 0
-                                && comps.find(lj) == *root
+                                && comps.find(lj) == root
                                 && bridges_body(mean_dn, pw, level_dn, i, j)
                         })
                     })
                 });
                 if near {
-                    *root = comps.union(*root, r);
-                    b = *comps.stats(usize::from(*root))?;
+                    root = comps.union(root, r);
+                    b = comps.stats(usize::from(root)).copied().unwrap_or(b);
                     changed = true;
+                    joined = true;
                 }
             }
             y += 1;
         }
-        joined |= changed;
         if !changed {
             break;
         }
     }
-    if !joined {
-        return None;
-    }
-    Some((*root, *comps.stats(usize::from(*root))?))
+    let out = if joined {
+        comps.stats(usize::from(root)).map(|&s| (root, s))
+    } else {
+        None
+    };
+    (out, looks)
 }
 
 /// Most components stage 4b rates ([`AutoV2::candidates`]): the model's cost per
