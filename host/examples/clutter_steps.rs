@@ -63,6 +63,7 @@ fn main() {
     for dir in dirs {
         let meta = common::metadata(&dir);
         let list = common::frames(&dir);
+        // Each kept frame with its rendered noise σ at the NETD (`noise_sigma_dn`).
         let kept: Vec<_> = list
             .iter()
             .zip(&meta)
@@ -73,17 +74,11 @@ fn main() {
                         .as_deref()
                         .is_none_or(|md| m["mode"].as_str() == Some(md))
             })
-            .map(|(e, _)| e.clone())
-            .collect();
-        let netd_sigma: Vec<Option<f64>> = list
-            .iter()
-            .zip(&meta)
-            .filter(|((f, _, _), _)| kept.iter().any(|(k, _, _)| k == f))
-            .map(|(_, m)| m["noise_sigma_dn"].as_f64().filter(|&v| v > 0.0))
+            .map(|(e, m)| (e.clone(), m["noise_sigma_dn"].as_f64().filter(|&v| v > 0.0)))
             .collect();
         let per_frame: Vec<_> = kept
             .par_iter()
-            .map(|(file, bits, _)| {
+            .map(|((file, bits, _), netd_sigma)| {
                 let f = read_frame(&dir.join(file), Some(*bits)).unwrap_or_else(|e| {
                     eprintln!("{}: {e}", dir.join(file).display());
                     std::process::exit(2)
@@ -99,7 +94,7 @@ fn main() {
                     c[bin][0] += 1;
                     c[bin][1] += u64::from(forest::FLIGHT.score(feats) >= floor);
                 });
-                (c, sigma)
+                (c, netd_sigma.map(|n| f64::from(sigma) / n))
             })
             .collect();
         let mut counts = [[0u64; 2]; BIN_ENDS_SIGMA.len() + 1];
@@ -112,11 +107,7 @@ fn main() {
         // The detector's noise σ over the renderer's noise σ at the camera's NETD (the
         // metadata's `noise_sigma_dn`): above 1 where the camera's signature or the
         // scene's texture raise the estimate.
-        let mut ratios: Vec<f64> = per_frame
-            .iter()
-            .zip(&netd_sigma)
-            .filter_map(|((_, s), n)| n.map(|n| f64::from(*s) / n))
-            .collect();
+        let mut ratios: Vec<f64> = per_frame.iter().filter_map(|(_, r)| *r).collect();
         ratios.sort_by(f64::total_cmp);
         let median_ratio = ratios.get(ratios.len() / 2).copied();
         let cells: u64 = counts.iter().map(|c| c[0]).sum();
