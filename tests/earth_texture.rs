@@ -200,6 +200,43 @@ fn stats_tool_reproduces_the_real_image_readme() {
         s.spectral_slope
     );
     assert_eq!(s.bt_k, [259.5, 292.0, 296.0]);
+    // Small cold elements (session 38): measured independently with scipy
+    // (`ndimage.median_filter` 11 × 11, `ndimage.label` 8-connected): 2.7 small and
+    // 0.5 mid-sized per 10⁴ px (scipy's median fills the no-data pixels, ours skips them).
+    let [small, mid] = s.cold_features_per_10k_px;
+    assert!((2.3..=2.9).contains(&small), "small cold features {small}");
+    assert!((0.3..=0.7).contains(&mid), "mid cold features {mid}");
+}
+
+/// The cold-feature count against a brute-force reference on a drawn image: a flat
+/// 280 K field with three cold elements of 1, 9 and 30 px (−25 K) and one 9-px element
+/// only −10 K deep (not counted), on 64 × 64 px.
+#[test]
+fn cold_features_count_small_and_mid_elements() {
+    use tirroi_host::world::earth::texture_stats::cold_features;
+    let (w, h) = (64, 64);
+    let mut t = vec![280.0; w * h];
+    let mut paint = |x0: usize, y0: usize, bw: usize, bh: usize, dt: f64| {
+        for y in y0..y0 + bh {
+            for x in x0..x0 + bw {
+                t[y * w + x] = 280.0 - dt;
+            }
+        }
+    };
+    paint(5, 5, 1, 1, 25.0);
+    paint(20, 5, 3, 3, 25.0);
+    paint(40, 30, 6, 5, 25.0);
+    paint(10, 40, 3, 3, 10.0);
+    let [small, mid] = cold_features(&t, w, h);
+    let per = 1e4 / (w * h) as f64;
+    assert!((small - 2.0 * per).abs() < 1e-9, "{small}");
+    assert!((mid - per).abs() < 1e-9, "{mid}");
+    // No data is neither counted nor a neighbour.
+    let mut holes = t.clone();
+    holes[5 * w + 5] = f64::NAN;
+    let [small, _] = cold_features(&holes, w, h);
+    let per = 1e4 / (w * h - 1) as f64;
+    assert!((small - per).abs() < 1e-9, "{small}");
 }
 
 /// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K, over 8 patches
@@ -209,11 +246,15 @@ fn stats_tool_reproduces_the_real_image_readme() {
 /// patches (session 23, with the deep-convective regime and its cloud-top texture:
 /// p99 10–14.5 K, share 0.77–3.24 %, slope −2.44…−3.15; the two misses are mild
 /// patches at the ranges' edges: share 0.77 % at (20°, 202°) and slope −2.44 at
-/// (45°, 330°) on day 0).
+/// (45°, 330°) on day 0). Session 38 adds the small cold features (`TextureStats::
+/// cold_features_per_10k_px`): median within ½–2× the real mild scene's 2.6 per 10⁴ px,
+/// present on at least 7 of 8 patches (with the cold fragments: 0.6–5.2, median 2.1,
+/// slope −2.34…−3.09, share 1.0–3.2 %).
 #[test]
 fn texture_statistics_within_the_acceptance_ranges() {
     let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
     let (mut p99, mut share, mut slope) = (Vec::new(), Vec::new(), Vec::new());
+    let mut small_cold = Vec::new();
     for day in 0..2 {
         let f = field(1, day);
         for &(lat, lon) in &places {
@@ -225,6 +266,11 @@ fn texture_statistics_within_the_acceptance_ranges() {
                 100.0 * s.step2_share_over[1],
                 s.spectral_slope
             );
+            eprintln!(
+                "  cold features small / mid per 10⁴ px: {:.1} / {:.1}",
+                s.cold_features_per_10k_px[0], s.cold_features_per_10k_px[1]
+            );
+            small_cold.push(s.cold_features_per_10k_px[0]);
             p99.push(s.step2_k[2]);
             share.push(s.step2_share_over[1]);
             slope.push(s.spectral_slope);
@@ -247,6 +293,19 @@ fn texture_statistics_within_the_acceptance_ranges() {
     assert!(
         shares_in >= 7,
         "{shares_in} patches with the share in range"
+    );
+    // Small cold elements (session 38): the real mild scene has 2.6 per 10⁴ px, the
+    // texture without its cold fragments had 0.0–0.8 (median 0.0) on these patches.
+    small_cold.sort_by(f64::total_cmp);
+    let c_med = 0.5 * (small_cold[3] + small_cold[4]);
+    eprintln!("median small cold features {c_med:.1} per 10⁴ px");
+    assert!(
+        (1.3..=5.2).contains(&c_med),
+        "median small cold features {c_med}"
+    );
+    assert!(
+        small_cold.iter().filter(|&&c| c > 0.0).count() >= 7,
+        "cold fragments missing on patches: {small_cold:?}"
     );
     let slopes_in = slope.iter().filter(|k| (-3.3..=-2.5).contains(*k)).count();
     slope.sort_by(f64::total_cmp);

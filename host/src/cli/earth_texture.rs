@@ -55,7 +55,7 @@ pub fn builtin_field(seed: u64, day: u64) -> CloudField {
 
 fn row(name: &str, s: &TextureStats) -> String {
     format!(
-        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} |",
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} |",
         s.step2_k[0],
         s.step2_k[1],
         s.step2_k[2],
@@ -67,6 +67,8 @@ fn row(name: &str, s: &TextureStats) -> String {
         s.bt_k[0],
         s.bt_k[1],
         s.bt_k[2],
+        s.cold_features_per_10k_px[0],
+        s.cold_features_per_10k_px[1],
     )
 }
 
@@ -98,9 +100,9 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(
-            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K |"
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px |"
         );
-        println!("|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|");
         for day in 0..args.days {
             let field = builtin_field(args.seed, day);
             for &(lat, lon) in &PATCH_CENTRES {

@@ -29,6 +29,13 @@
 //!   one deck hundreds of km wide; beyond [`EDGE_WIDTH_FULL_DEPTH_K`] a deck's edge
 //!   steps as a 40 K cloud and the rest of its depth comes inside it (cold cores,
 //!   [`DEEP_CORE_WIDTHS`] edge widths in);
+//! - cold fragments (session 38): where a fragment field z (a 20 km value-noise octave
+//!   compressed ×3 north–south, plus a 150 km one that clusters them, in σ) exceeds
+//!   [`FRAGMENT_THRESHOLD_SIGMA`] (more in clear air), a top 18–40 K colder than the
+//!   clear sky covers what is below it, with a ~1 km edge: the small cold cloud elements
+//!   and dashes (towers, cirrus fragments) of real 4 km imagery, 1–12 px across, which
+//!   the cloud partition alone never made (its low clouds are 10–21 K deep, its deep
+//!   ones wide decks). They are in the tile, so the cell's balance below keeps the flux;
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
 //!   (more or less cloud where the noise realisation has too little or too much); s
@@ -156,6 +163,36 @@ pub const MESOSCALE_OCTAVES: std::ops::Range<usize> = 3..6;
 pub const CLOUD_TOP_TEXTURE_K: f64 = 3.0;
 /// The cloud-top texture's noise is clipped at this many σ (so it stays a few K).
 pub const CLOUD_TOP_TEXTURE_CLIP: f64 = 2.0;
+/// Lattice of the cold-fragment noise, km: a value-noise peak above a high threshold
+/// is a few km to ~15 km across, 1–4 px at 4 km (session 38: real longwave imagery at
+/// 4 km holds small cloud elements 16–40 K colder than their surroundings, 2.7 per
+/// 10⁴ px in the mild reference scene; the cloud partition alone made none, as its low
+/// clouds are 10–21 K deep and its deep ones wide decks).
+pub const FRAGMENT_LATTICE_KM: f64 = 20.0;
+/// East–west elongation of the fragments (their lattice compressed north–south by this):
+/// the real scene's small cold elements are often dashes along the flow.
+pub const FRAGMENT_STRETCH: f64 = 3.0;
+/// Lattice of the noise that clusters the fragments, km: they come in groups tens to
+/// hundreds of km wide (fields of towers, broken cirrus), not spread evenly.
+pub const FRAGMENT_CLUSTER_LATTICE_KM: f64 = 150.0;
+/// Weight of the cluster noise (in its σ) added to the fragment noise (in its σ).
+pub const FRAGMENT_CLUSTER_GAIN: f64 = 1.0;
+/// Threshold of the fragment field z = n_f/σ_f + gain·n_c/σ_c, in σ of z: above it a
+/// point belongs to a fragment. Sets their number (calibrated on the cold-feature count
+/// of `TextureStats`, see `tests/earth_texture.rs`).
+pub const FRAGMENT_THRESHOLD_SIGMA: f64 = 2.35;
+/// Extra threshold where the point's cloud fraction c is 0 (scaled by 1 − c), σ of z:
+/// fragments grow in cloudy air, a few in clear subsidence regions.
+pub const FRAGMENT_CLEAR_PENALTY_SIGMA: f64 = 0.4;
+/// Width of a fragment's edge, σ of z: about a kilometre, so a fragment steps within a
+/// pixel as a small cumulonimbus tower or a cirrus fragment does.
+pub const FRAGMENT_EDGE_SIGMA: f64 = 0.3;
+/// A fragment's top is this much colder than the clear sky at its edge, K ...
+pub const FRAGMENT_MIN_COLD_K: f64 = 18.0;
+/// ... and this much at its core, K (tops of congestus and small cumulonimbus cells).
+pub const FRAGMENT_MAX_COLD_K: f64 = 40.0;
+/// Rise of z above the threshold over which a fragment reaches its core depth, σ of z.
+pub const FRAGMENT_CORE_SIGMA: f64 = 0.6;
 /// Sample points per axis of a cell's energy balance (16 × 16, cell-centred).
 pub const BALANCE_SAMPLES: usize = 16;
 /// Largest shift of a cell's cloud threshold its balance may use, noise σ (session 24:
@@ -220,6 +257,37 @@ struct Octave {
     amplitude: f64,
 }
 
+impl Octave {
+    /// An octave of lattice `lattice_km`, compressed north–south by `stretch`, with a
+    /// uniformly random rotation (Shoemake's random unit quaternion) and offset drawn
+    /// from `unif` (six draws in [0, 1)).
+    fn random(
+        unif: &mut impl FnMut() -> f64,
+        lattice_km: f64,
+        stretch: f64,
+        amplitude: f64,
+    ) -> Octave {
+        let (u1, u2, u3) = (unif(), unif(), unif());
+        let tau = 2.0 * std::f64::consts::PI;
+        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+        let [x, y, z, w] = [
+            a * libm::sin(tau * u2),
+            a * libm::cos(tau * u2),
+            b * libm::sin(tau * u3),
+            b * libm::cos(tau * u3),
+        ];
+        let rot = Rotation::from_quaternion([w, x, y, z]).0;
+        let offset = [unif() * 1e3, unif() * 1e3, unif() * 1e3];
+        Octave {
+            rot,
+            inv_lattice_km: 1.0 / lattice_km,
+            stretch,
+            offset,
+            amplitude,
+        }
+    }
+}
+
 /// What a cell caches: coarse noise at its 9 × 9 nodes and its balance factors.
 #[derive(Debug, Clone)]
 struct Cell {
@@ -259,6 +327,10 @@ struct Point {
     deep: f64,
     /// Cloud-top texture of a deep-convective cloud, K (added to its depth).
     top_texture: f64,
+    /// Cover of a cold fragment, 0…1 (0 almost everywhere).
+    fragment: f64,
+    /// Temperature of the fragment's top, K (where `fragment` > 0).
+    fragment_top_k: f64,
 }
 
 /// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
@@ -268,6 +340,10 @@ pub struct CloudField {
     flux: Vec<f32>,
     table: Vec<f32>,
     octaves: Vec<Octave>,
+    /// The cold fragments' noise and the noise that clusters them.
+    fragment_octaves: [Octave; 2],
+    /// Standard deviation of each of `fragment_octaves`.
+    fragment_sigma: [f64; 2],
     quantiles: [f64; QUANTILES + 1],
     sigma: f64,
     /// Standard deviation of the octaves finer than the mesoscale ones (σ × their
@@ -294,6 +370,8 @@ impl Clone for CloudField {
             flux: self.flux.clone(),
             table: self.table.clone(),
             octaves: self.octaves.clone(),
+            fragment_octaves: self.fragment_octaves.clone(),
+            fragment_sigma: self.fragment_sigma,
             quantiles: self.quantiles,
             sigma: self.sigma,
             small_sigma: self.small_sigma,
@@ -354,34 +432,26 @@ impl CloudField {
             .iter()
             .enumerate()
             .map(|(i, &l)| {
-                // A uniformly random rotation from a random unit quaternion (Shoemake).
-                let (u1, u2, u3) = (unif(), unif(), unif());
-                let tau = 2.0 * std::f64::consts::PI;
-                let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-                let q = [
-                    a * libm::sin(tau * u2),
-                    a * libm::cos(tau * u2),
-                    b * libm::sin(tau * u3),
-                    b * libm::cos(tau * u3),
-                ];
-                let [x, y, z, w] = q;
-                let rot = Rotation::from_quaternion([w, x, y, z]).0;
-                let offset = [unif() * 1e3, unif() * 1e3, unif() * 1e3];
-                let o = Octave {
-                    rot,
-                    inv_lattice_km: 1.0 / l,
-                    stretch: if i < COARSE_OCTAVES {
-                        ZONAL_STRETCH
-                    } else {
-                        1.0
-                    },
-                    offset,
-                    amplitude,
+                let stretch = if i < COARSE_OCTAVES {
+                    ZONAL_STRETCH
+                } else {
+                    1.0
                 };
+                let o = Octave::random(&mut unif, l, stretch, amplitude);
                 amplitude *= OCTAVE_GAIN;
                 o
             })
             .collect();
+        // The fragments' own stream, so the cloud partition's octaves are those of
+        // the texture without fragments.
+        let mut frng = Xoshiro128pp::seed_from_u64(crate::seed::splitmix64(
+            seed ^ crate::seed::splitmix64(day.wrapping_add(0xF4A6)),
+        ));
+        let mut funif = || f64::from(frng.next_u32()) / 4_294_967_296.0;
+        let fragment_octaves = [
+            Octave::random(&mut funif, FRAGMENT_LATTICE_KM, FRAGMENT_STRETCH, 1.0),
+            Octave::random(&mut funif, FRAGMENT_CLUSTER_LATTICE_KM, 1.0, 1.0),
+        ];
         let rows = (180.0 / CLEAR_STEP_DEG) as usize + 1;
         let clear_t_k = (0..rows)
             .map(|i| {
@@ -395,6 +465,8 @@ impl CloudField {
             flux: grid.values().to_vec(),
             table,
             octaves,
+            fragment_octaves,
+            fragment_sigma: [1.0; 2],
             quantiles: [0.0; QUANTILES + 1],
             sigma: 1.0,
             small_sigma: 1.0,
@@ -416,15 +488,26 @@ impl CloudField {
         };
         // The noise's distribution on random directions (fixed stream: deterministic).
         let mut srng = Xoshiro128pp::seed_from_u64(0x5A3F_1E5D);
+        let mut fragment_moments = [(0.0f64, 0.0f64); 2];
         let mut values: Vec<f64> = (0..DISTRIBUTION_SAMPLES)
             .map(|_| {
                 let z = f64::from(srng.next_u32()) / 4_294_967_296.0 * 2.0 - 1.0;
                 let phi = f64::from(srng.next_u32()) / 4_294_967_296.0 * std::f64::consts::TAU;
                 let r = (1.0 - z * z).sqrt();
                 let p = [r * libm::cos(phi), r * libm::sin(phi), z];
+                for (k, o) in field.fragment_octaves.iter().enumerate() {
+                    let v = field.octave_noise(o, p);
+                    fragment_moments[k].0 += v;
+                    fragment_moments[k].1 += v * v;
+                }
                 field.noise(p, 0..field.octaves.len())
             })
             .collect();
+        let count = DISTRIBUTION_SAMPLES as f64;
+        field.fragment_sigma = fragment_moments.map(|(s, s2)| {
+            let m = s / count;
+            (s2 / count - m * m).max(1e-12).sqrt()
+        });
         values.sort_by(f64::total_cmp);
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / values.len() as f64;
@@ -443,18 +526,23 @@ impl CloudField {
 
     /// Sum of the octaves in `range` at unit vector `p`.
     fn noise(&self, p: [f64; 3], range: std::ops::Range<usize>) -> f64 {
-        let mut sum = 0.0;
-        for o in &self.octaves[range] {
-            let s = NOISE_RADIUS_KM * o.inv_lattice_km;
-            let v = [p[0] * s, p[1] * s, p[2] * s * o.stretch];
-            let q = [
-                o.rot[0][0] * v[0] + o.rot[0][1] * v[1] + o.rot[0][2] * v[2] + o.offset[0],
-                o.rot[1][0] * v[0] + o.rot[1][1] * v[1] + o.rot[1][2] * v[2] + o.offset[1],
-                o.rot[2][0] * v[0] + o.rot[2][1] * v[1] + o.rot[2][2] * v[2] + o.offset[2],
-            ];
-            sum += o.amplitude * self.value_noise(q);
-        }
-        sum
+        self.octaves[range]
+            .iter()
+            .map(|o| self.octave_noise(o, p))
+            .sum()
+    }
+
+    /// One octave `o` at unit vector `p` (its amplitude included).
+    #[inline]
+    fn octave_noise(&self, o: &Octave, p: [f64; 3]) -> f64 {
+        let s = NOISE_RADIUS_KM * o.inv_lattice_km;
+        let v = [p[0] * s, p[1] * s, p[2] * s * o.stretch];
+        let q = [
+            o.rot[0][0] * v[0] + o.rot[0][1] * v[1] + o.rot[0][2] * v[2] + o.offset[0],
+            o.rot[1][0] * v[0] + o.rot[1][1] * v[1] + o.rot[1][2] * v[2] + o.offset[1],
+            o.rot[2][0] * v[0] + o.rot[2][1] * v[1] + o.rot[2][2] * v[2] + o.offset[2],
+        ];
+        o.amplitude * self.value_noise(q)
     }
 
     /// Trilinear value noise (smoothstep weights) of the lattice table at `q`.
@@ -513,7 +601,15 @@ impl CloudField {
     /// grain, K; cloud depth ΔT, K; base threshold θ; noise n).
     /// `n` holds the noise's (coarse, mesoscale, finer) parts; they are weighted by the
     /// deep-convective regime of the point's ΔT.
-    fn point(&self, lat_deg: f64, lon_deg: f64, n: [f64; 3], n_fine: f64) -> Point {
+    /// `z_fragment` is the fragment field in its σ (see [`FRAGMENT_THRESHOLD_SIGMA`]).
+    fn point(
+        &self,
+        lat_deg: f64,
+        lon_deg: f64,
+        n: [f64; 3],
+        n_fine: f64,
+        z_fragment: f64,
+    ) -> Point {
         let n_small = n[2];
         let f = self.flux_at(lat_deg, lon_deg);
         let t_clear = self
@@ -551,6 +647,17 @@ impl CloudField {
         let top_texture = deep
             * CLOUD_TOP_TEXTURE_K
             * (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
+        // Cold fragments: above a threshold that rises where the air is clear, a
+        // sharp-edged top 18 K colder than the clear sky at the edge, 40 K at the core.
+        let over = z_fragment - FRAGMENT_THRESHOLD_SIGMA - (1.0 - c) * FRAGMENT_CLEAR_PENALTY_SIGMA;
+        let (fragment, fragment_top_k) = if over > -0.5 * FRAGMENT_EDGE_SIGMA {
+            let cold = FRAGMENT_MIN_COLD_K
+                + (FRAGMENT_MAX_COLD_K - FRAGMENT_MIN_COLD_K)
+                    * smoothstep(over / FRAGMENT_CORE_SIGMA);
+            (smoothstep(over / FRAGMENT_EDGE_SIGMA + 0.5), t_clear - cold)
+        } else {
+            (0.0, t_clear)
+        };
         Point {
             t_clear: t_clear + grain,
             dt,
@@ -559,6 +666,8 @@ impl CloudField {
             width,
             deep,
             top_texture,
+            fragment,
+            fragment_top_k,
         }
     }
 
@@ -926,7 +1035,9 @@ impl CloudField {
         } else {
             cold
         };
-        p.t_clear - cold.min(MAX_LOCAL_COLD_K)
+        let t = p.t_clear - cold.min(MAX_LOCAL_COLD_K);
+        // A fragment's top hides what is below it where it is colder.
+        t - p.fragment * (t - p.fragment_top_k).max(0.0)
     }
 
     /// The point at fractions (u lat, v lon) of `cell`.
@@ -943,7 +1054,23 @@ impl CloudField {
         let meso = self.noise(p, MESOSCALE_OCTAVES);
         let small = self.noise(p, MESOSCALE_OCTAVES.end..last - 1);
         let fine = self.noise(p, last - 1..last);
-        self.point(lat, lon, [coarse, meso, small + fine], fine)
+        self.point(
+            lat,
+            lon,
+            [coarse, meso, small + fine],
+            fine,
+            self.fragment_z(p),
+        )
+    }
+
+    /// The fragment field at unit vector `p` in its own σ: the fragment noise plus
+    /// [`FRAGMENT_CLUSTER_GAIN`] × the cluster noise, each in its σ, normalised.
+    fn fragment_z(&self, p: [f64; 3]) -> f64 {
+        let [of, oc] = &self.fragment_octaves;
+        let nf = self.octave_noise(of, p) / self.fragment_sigma[0];
+        let nc = self.octave_noise(oc, p) / self.fragment_sigma[1];
+        (nf + FRAGMENT_CLUSTER_GAIN * nc)
+            / (1.0 + FRAGMENT_CLUSTER_GAIN * FRAGMENT_CLUSTER_GAIN).sqrt()
     }
 
     /// Weights of the (coarse, mesoscale) noise in a deep-convective regime of weight

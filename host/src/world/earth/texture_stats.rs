@@ -16,6 +16,19 @@ pub const PATCH_PX_KM: f64 = 4.0;
 pub const SLOPE_BAND_KM: (f64, f64) = (8.0, 200.0);
 /// Logarithmic frequency bins over [`SLOPE_BAND_KM`] for the ring average.
 const SLOPE_BINS: usize = 12;
+/// A pixel is part of a cold feature when it is this much colder than the median of
+/// its [`LOCAL_MEDIAN_PX`]² neighbourhood, K: deeper than a low cloud's edge step (the
+/// real mild scene's 2-px p99 is 11 K), as deep as a small cold cloud element that a
+/// detector can take for a target's outline.
+pub const COLD_FEATURE_DEPTH_K: f64 = 16.0;
+/// Side of the neighbourhood whose median is the local background, px (44 km at 4 km:
+/// wider than a small cloud element, narrower than a cloud deck).
+pub const LOCAL_MEDIAN_PX: usize = 11;
+/// Largest small cold feature, px (≤ 12 px: one to a few pixels across); larger ones
+/// up to [`MID_FEATURE_MAX_PX`] count as mid-sized.
+pub const SMALL_FEATURE_MAX_PX: usize = 12;
+/// Largest mid-sized cold feature, px.
+pub const MID_FEATURE_MAX_PX: usize = 60;
 
 /// Statistics of one image (see the README's table).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,6 +41,10 @@ pub struct TextureStats {
     pub spectral_slope: f64,
     /// Brightness temperature p1, p50, p99, K.
     pub bt_k: [f64; 3],
+    /// Cold features per 10⁴ valid pixels: 8-connected groups of pixels more than
+    /// [`COLD_FEATURE_DEPTH_K`] below their local median, small (≤
+    /// [`SMALL_FEATURE_MAX_PX`] px) and mid-sized (≤ [`MID_FEATURE_MAX_PX`] px).
+    pub cold_features_per_10k_px: [f64; 2],
     /// Number of 2-px steps measured.
     pub steps: usize,
 }
@@ -79,9 +96,72 @@ impl TextureStats {
             step2_share_over: [over(5.0), over(10.0), over(20.0)],
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
+            cold_features_per_10k_px: cold_features(t_k, w, h),
             steps: steps.len(),
         })
     }
+}
+
+/// Small and mid-sized cold features per 10⁴ valid pixels of the row-major `w` × `h`
+/// image `t_k` (K, NaN = no data; see [`TextureStats::cold_features_per_10k_px`]): the
+/// local median over the valid pixels of each window, then 8-connected groups of the
+/// pixels below it by more than [`COLD_FEATURE_DEPTH_K`], sized by flood fill.
+pub fn cold_features(t_k: &[f64], w: usize, h: usize) -> [f64; 2] {
+    let r = LOCAL_MEDIAN_PX / 2;
+    let mut cold = vec![false; w * h];
+    let mut window: Vec<f64> = Vec::with_capacity(LOCAL_MEDIAN_PX * LOCAL_MEDIAN_PX);
+    let mut valid = 0usize;
+    for y in 0..h {
+        for x in 0..w {
+            let t = t_k[y * w + x];
+            if !t.is_finite() {
+                continue;
+            }
+            valid += 1;
+            window.clear();
+            for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
+                let line = &t_k[yy * w..yy * w + w];
+                window.extend(
+                    line[x.saturating_sub(r)..(x + r + 1).min(w)]
+                        .iter()
+                        .filter(|v| v.is_finite()),
+                );
+            }
+            let mid = window.len() / 2;
+            let (_, median, _) = window.select_nth_unstable_by(mid, f64::total_cmp);
+            cold[y * w + x] = t < *median - COLD_FEATURE_DEPTH_K;
+        }
+    }
+    let mut counts = [0usize; 2];
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if !cold[start] {
+            continue;
+        }
+        cold[start] = false;
+        stack.push(start);
+        let mut size = 0usize;
+        while let Some(i) = stack.pop() {
+            size += 1;
+            let (x, y) = (i % w, i / w);
+            for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let j = yy * w + xx;
+                    if cold[j] {
+                        cold[j] = false;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        if size <= SMALL_FEATURE_MAX_PX {
+            counts[0] += 1;
+        } else if size <= MID_FEATURE_MAX_PX {
+            counts[1] += 1;
+        }
+    }
+    let per = 1e4 / valid.max(1) as f64;
+    [counts[0] as f64 * per, counts[1] as f64 * per]
 }
 
 /// Slope of log power vs log frequency of the 2-D ring-averaged power spectrum of the
