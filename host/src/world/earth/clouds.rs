@@ -20,7 +20,7 @@
 //!   ones stretched north–south so that bands run east–west) and θ its (1 − c)
 //!   quantile, so about a share c of the area is cloudy; the transition width
 //!   [`EDGE_WIDTH_SIGMA`] gives 1–3 px cloud edges at 4 km per pixel;
-//! - ΔT_local grows from 0.65 ΔT at a cloud's edge to 1.35 ΔT in its core; the edge
+//! - ΔT_local grows from 0.7 ΔT at a cloud's edge to 1.3 ΔT in its core; the edge
 //!   width grows with ΔT (cold high-cloud fringes are softer than low-cloud edges);
 //! - deep convection (ΔT above [`DEEP_CONVECTION_ONSET_K`]): the coarse octaves weigh
 //!   [`DEEP_COARSE_WEIGHT`] and the [`MESOSCALE_OCTAVES`] take their variance, the edge
@@ -31,7 +31,7 @@
 //!   [`DEEP_CORE_WIDTHS`] edge widths in);
 //! - cold fragments (session 38): where a fragment field z (a 20 km value-noise octave
 //!   compressed ×3 north–south, plus a 150 km one that clusters them, in σ) exceeds
-//!   [`FRAGMENT_THRESHOLD_SIGMA`] (more in clear air), a top 18–40 K colder than the
+//!   [`FRAGMENT_THRESHOLD_SIGMA`] (anywhere, clear or cloudy), a top 18–40 K colder than the
 //!   clear sky covers what is below it, with a ~1 km edge: the small cold cloud elements
 //!   and dashes (towers, cirrus fragments) of real 4 km imagery, 1–12 px across, which
 //!   the cloud partition alone never made (its low clouds are 10–21 K deep, its deep
@@ -90,9 +90,12 @@ pub const EDGE_WIDTH_SIGMA: f64 = 0.10;
 /// the real scenes' range from trade cumulus to deep convection. (Evaluated as
 /// x²·√x.)
 pub const EDGE_WIDTH_DEPTH_EXPONENT: f64 = 2.5;
-/// Share of a cloud's depth ΔT reached at its edge; the core reaches 2 − this (0.65:
-/// a 15.5 K low cloud steps by ~10 K at its edge, the real mild scene's 2-px p99).
-pub const EDGE_DEPTH_SHARE: f64 = 0.65;
+/// Share of a cloud's depth ΔT reached at its edge; the core reaches 2 − this (0.7:
+/// a 15.5 K low cloud steps by ~11 K at its edge, the real mild scene's 2-px p99).
+/// Session 38: was 0.65; with the clear grain at its stated amplitude (below) the
+/// trade-cumulus patches' share of 2-px steps over 10 K fell to 0.65–0.75 % (range
+/// 0.8–3.5 %, real 1.2 %); at 0.7 it is 1.1–1.3 %.
+pub const EDGE_DEPTH_SHARE: f64 = 0.7;
 /// Missing clear-sky flux share r at which a point is overcast: the cloud fraction is
 /// c = √(r / r_overcast), so thin deficits come as many shallow (low) clouds and large
 /// ones as deep, wide decks (r = 0.05: 41 % cloud; r = 0.45: 95 %).
@@ -125,7 +128,10 @@ pub const EDGE_WIDTH_FULL_DEPTH_K: f64 = 40.0;
 /// real convective scene's range.
 pub const DEEP_CORE_WIDTHS: f64 = 3.0;
 /// Peak-to-peak amplitude of the clear-sky grain (unresolved trade cumulus, surface
-/// and humidity texture), K.
+/// and humidity texture), K: the finest (6 km) octave in its own σ, clipped at ±1 σ.
+/// Session 38 fixed its normalisation: it divided by the whole noise's σ, ~17× the
+/// finest octave's, so the grain was ~0.06 K rms instead of ~1 K, and the real image's
+/// small steps were missing (2-px steps over 0.5 K: 31 % ours, 62 % real; now 66 %).
 pub const CLEAR_GRAIN_K: f64 = 2.0;
 /// Half-width of the band along each cell border where the scale s blends with the
 /// neighbour cell's, in cell fractions (0.15° ≈ 17 km of latitude: about 4 px at 4 km
@@ -180,10 +186,7 @@ pub const FRAGMENT_CLUSTER_GAIN: f64 = 1.0;
 /// Threshold of the fragment field z = n_f/σ_f + gain·n_c/σ_c, in σ of z: above it a
 /// point belongs to a fragment. Sets their number (calibrated on the cold-feature count
 /// of `TextureStats`, see `tests/earth_texture.rs`).
-pub const FRAGMENT_THRESHOLD_SIGMA: f64 = 2.35;
-/// Extra threshold where the point's cloud fraction c is 0 (scaled by 1 − c), σ of z:
-/// fragments grow in cloudy air, a few in clear subsidence regions.
-pub const FRAGMENT_CLEAR_PENALTY_SIGMA: f64 = 0.4;
+pub const FRAGMENT_THRESHOLD_SIGMA: f64 = 2.55;
 /// Width of a fragment's edge, σ of z: about a kilometre, so a fragment steps within a
 /// pixel as a small cumulonimbus tower or a cirrus fragment does.
 pub const FRAGMENT_EDGE_SIGMA: f64 = 0.3;
@@ -618,7 +621,7 @@ impl CloudField {
         let f_clear = STEFAN_BOLTZMANN_W_M2_K4 * t_clear.powi(4);
         let r = (1.0 - f / f_clear).clamp(0.0, 0.9);
         let c = (r / OVERCAST_DEFICIT).sqrt().min(MAX_CLOUD_FRACTION);
-        let grain = CLEAR_GRAIN_K * (n_fine / self.sigma).clamp(-1.0, 1.0) * 0.5;
+        let grain = CLEAR_GRAIN_K * (n_fine / self.small_sigma).clamp(-1.0, 1.0) * 0.5;
         let (dt, theta) = if c <= 1e-4 {
             (MIN_CLOUD_COLD_K, self.quantile(1.0 - 1e-4))
         } else {
@@ -647,9 +650,10 @@ impl CloudField {
         let top_texture = deep
             * CLOUD_TOP_TEXTURE_K
             * (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
-        // Cold fragments: above a threshold that rises where the air is clear, a
-        // sharp-edged top 18 K colder than the clear sky at the edge, 40 K at the core.
-        let over = z_fragment - FRAGMENT_THRESHOLD_SIGMA - (1.0 - c) * FRAGMENT_CLEAR_PENALTY_SIGMA;
+        // Cold fragments: above the threshold, a sharp-edged top 18 K colder than the
+        // clear sky at the edge, 40 K at the core, whatever the cloud fraction (the
+        // real mild scene has them over clear sea and trade cumulus alike).
+        let over = z_fragment - FRAGMENT_THRESHOLD_SIGMA;
         let (fragment, fragment_top_k) = if over > -0.5 * FRAGMENT_EDGE_SIGMA {
             let cold = FRAGMENT_MIN_COLD_K
                 + (FRAGMENT_MAX_COLD_K - FRAGMENT_MIN_COLD_K)
@@ -1021,7 +1025,7 @@ impl CloudField {
     fn temperature(&self, p: &Point, shift: f64) -> f64 {
         let x = p.n - p.theta - shift;
         let m = smoothstep(x / p.width + 0.5);
-        // Deeper (colder) towards a cloud's core: 0.65 ΔT at the edge, 1.35 ΔT well inside.
+        // Deeper (colder) towards a cloud's core: 0.7 ΔT at the edge, 1.3 ΔT well inside.
         let core = smoothstep(x / (1.2 * self.sigma));
         // Deep convection: flat anvil tops (depth 1) instead of the deepening core.
         let depth = EDGE_DEPTH_SHARE + 2.0 * (1.0 - EDGE_DEPTH_SHARE) * core;
