@@ -32,7 +32,7 @@
 //! - cold fragments (session 38): where a fragment field z (a 20 km value-noise octave
 //!   compressed ×3 north–south, plus a 150 km one that clusters them, in σ) exceeds
 //!   [`FRAGMENT_THRESHOLD_SIGMA`] (anywhere, clear or cloudy), a top 18–40 K colder than the
-//!   clear sky covers what is below it, with a ~1 km edge: the small cold cloud elements
+//!   clear sky covers what is below it, with a 1–2 px edge: the small cold cloud elements
 //!   and dashes (towers, cirrus fragments) of real 4 km imagery, 1–12 px across, which
 //!   the cloud partition alone never made (its low clouds are 10–21 K deep, its deep
 //!   ones wide decks). They are in the tile, so the cell's balance below keeps the flux;
@@ -187,8 +187,9 @@ pub const FRAGMENT_CLUSTER_GAIN: f64 = 1.0;
 /// point belongs to a fragment. Sets their number (calibrated on the cold-feature count
 /// of `TextureStats`, see `tests/earth_texture.rs`).
 pub const FRAGMENT_THRESHOLD_SIGMA: f64 = 2.55;
-/// Width of a fragment's edge, σ of z: about a kilometre, so a fragment steps within a
-/// pixel as a small cumulonimbus tower or a cirrus fragment does.
+/// Width of a fragment's edge, σ of z: about 2 km across a dash and 6 km along it
+/// (the 20 km lattice, compressed ×3), and no finer than the tile's 3.5 km nodes, so a
+/// fragment steps within 1–2 px as a small cumulonimbus tower or a cirrus fragment does.
 pub const FRAGMENT_EDGE_SIGMA: f64 = 0.3;
 /// A fragment's top is this much colder than the clear sky at its edge, K ...
 pub const FRAGMENT_MIN_COLD_K: f64 = 18.0;
