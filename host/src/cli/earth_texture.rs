@@ -55,11 +55,13 @@ pub fn builtin_field(seed: u64, day: u64) -> CloudField {
 
 fn row(name: &str, s: &TextureStats) -> String {
     format!(
-        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} |",
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} |",
         s.step2_k[0],
         s.step2_k[1],
         s.step2_k[2],
         s.step2_k[3],
+        100.0 * s.fine_step2_share_over[0],
+        100.0 * s.fine_step2_share_over[1],
         100.0 * s.step2_share_over[0],
         100.0 * s.step2_share_over[1],
         100.0 * s.step2_share_over[2],
@@ -100,9 +102,9 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(
-            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px |"
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px |"
         );
-        println!("|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|");
         for day in 0..args.days {
             let field = builtin_field(args.seed, day);
             for &(lat, lon) in &PATCH_CENTRES {

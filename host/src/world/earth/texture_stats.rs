@@ -37,6 +37,9 @@ pub struct TextureStats {
     pub step2_k: [f64; 4],
     /// Share of those steps above 5, 10 and 20 K (fractions, 0..=1).
     pub step2_share_over: [f64; 3],
+    /// Share of those steps above 1 and 2 K (fractions, 0..=1): the grain of trade
+    /// cumulus and clear-sky texture, which the larger steps do not see (session 38).
+    pub fine_step2_share_over: [f64; 2],
     /// Slope of the 2-D ring-averaged power spectrum over [`SLOPE_BAND_KM`].
     pub spectral_slope: f64,
     /// Brightness temperature p1, p50, p99, K.
@@ -94,6 +97,7 @@ impl TextureStats {
                 steps[steps.len() - 1],
             ],
             step2_share_over: [over(5.0), over(10.0), over(20.0)],
+            fine_step2_share_over: [over(1.0), over(2.0)],
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
             cold_features_per_10k_px: cold_features(t_k, w, h),
