@@ -941,11 +941,12 @@ impl CloudField {
         // A flux the shift cannot reach: the least shift that gets within
         // UNREACHED_SHARE of the reachable end (the cell just cleared or just overcast),
         // not the bound itself (s takes the rest).
-        let margin = UNREACHED_SHARE * (hi_f - lo_f);
-        let target = target.clamp(lo_f + margin, hi_f - margin);
-        let d = if hi_f - lo_f <= 0.0 {
+        // (Checked before the clamp, whose bounds must be ordered and not NaN.)
+        let d = if hi_f.partial_cmp(&lo_f) != Some(std::cmp::Ordering::Greater) {
             0.0
         } else {
+            let margin = UNREACHED_SHARE * (hi_f - lo_f);
+            let target = target.clamp(lo_f + margin, hi_f - margin);
             // Illinois false position: the flux is smooth and monotone in the shift.
             let (mut a, mut fa, mut b, mut fb) = (-lim, lo_f - target, lim, hi_f - target);
             let mut side = 0i8;
