@@ -191,13 +191,13 @@ fn stats_tool_reproduces_the_real_image_readme() {
         .collect();
     let s = TextureStats::of(&t, frame.width, frame.height, PATCH_PX_KM).expect("stats");
     assert_eq!(s.step2_k, [0.5, 4.0, 11.0, 44.0]);
-    assert!((s.step2_share_over[0] - 0.063).abs() < 0.001);
-    assert!((s.step2_share_over[1] - 0.012).abs() < 0.0005);
-    assert!((s.step2_share_over[2] - 0.0012).abs() < 0.0001);
+    assert!((s.step2_share_over[2] - 0.063).abs() < 0.001);
+    assert!((s.step2_share_over[3] - 0.012).abs() < 0.0005);
+    assert!((s.step2_share_over[4] - 0.0012).abs() < 0.0001);
     // The fine steps (session 38), measured independently with numpy on the same
     // pixels: 36.2 % over 1 K, 22.9 % over 2 K.
-    assert!((s.fine_step2_share_over[0] - 0.362).abs() < 0.001);
-    assert!((s.fine_step2_share_over[1] - 0.229).abs() < 0.001);
+    assert!((s.step2_share_over[0] - 0.362).abs() < 0.001);
+    assert!((s.step2_share_over[1] - 0.229).abs() < 0.001);
     assert!(
         (s.spectral_slope + 2.7).abs() < 0.05,
         "{}",
@@ -268,7 +268,7 @@ fn texture_statistics_within_the_acceptance_ranges() {
             eprintln!(
                 "day {day} ({lat}, {lon}): p99 {} K, share > 10 K {:.2} %, slope {:.2}",
                 s.step2_k[2],
-                100.0 * s.step2_share_over[1],
+                100.0 * s.step2_share_over[3],
                 s.spectral_slope
             );
             eprintln!(
@@ -277,7 +277,7 @@ fn texture_statistics_within_the_acceptance_ranges() {
             );
             small_cold.push(s.cold_features_per_10k_px[0]);
             p99.push(s.step2_k[2]);
-            share.push(s.step2_share_over[1]);
+            share.push(s.step2_share_over[3]);
             slope.push(s.spectral_slope);
         }
     }

@@ -16,6 +16,10 @@ pub const PATCH_PX_KM: f64 = 4.0;
 pub const SLOPE_BAND_KM: (f64, f64) = (8.0, 200.0);
 /// Logarithmic frequency bins over [`SLOPE_BAND_KM`] for the ring average.
 const SLOPE_BINS: usize = 12;
+/// The 2-px steps whose shares [`TextureStats::step2_share_over`] counts, K: 1 and 2 K
+/// (the grain of trade cumulus and clear-sky texture, session 38), 5, 10 and 20 K (the
+/// README's cloud edges).
+pub const STEP2_SHARE_K: [f64; 5] = [1.0, 2.0, 5.0, 10.0, 20.0];
 /// A pixel is part of a cold feature when it is this much colder than the median of
 /// its [`LOCAL_MEDIAN_PX`]² neighbourhood, K: deeper than a low cloud's edge step (the
 /// real mild scene's 2-px p99 is 11 K), as deep as a small cold cloud element that a
@@ -35,11 +39,8 @@ pub const MID_FEATURE_MAX_PX: usize = 60;
 pub struct TextureStats {
     /// |T(x+2) − T(x)| along rows: p50, p90, p99 and max, K.
     pub step2_k: [f64; 4],
-    /// Share of those steps above 5, 10 and 20 K (fractions, 0..=1).
-    pub step2_share_over: [f64; 3],
-    /// Share of those steps above 1 and 2 K (fractions, 0..=1): the grain of trade
-    /// cumulus and clear-sky texture, which the larger steps do not see (session 38).
-    pub fine_step2_share_over: [f64; 2],
+    /// Share of those steps above each of [`STEP2_SHARE_K`] (fractions, 0..=1).
+    pub step2_share_over: [f64; STEP2_SHARE_K.len()],
     /// Slope of the 2-D ring-averaged power spectrum over [`SLOPE_BAND_KM`].
     pub spectral_slope: f64,
     /// Brightness temperature p1, p50, p99, K.
@@ -96,8 +97,7 @@ impl TextureStats {
                 pct(&steps, 0.99),
                 steps[steps.len() - 1],
             ],
-            step2_share_over: [over(5.0), over(10.0), over(20.0)],
-            fine_step2_share_over: [over(1.0), over(2.0)],
+            step2_share_over: STEP2_SHARE_K.map(over),
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
             cold_features_per_10k_px: cold_features(t_k, w, h),
