@@ -58,8 +58,8 @@ const CONTRAST_CLAMP: i32 = 1024;
 /// `16 · log2(1 + v)` with the mantissa taken as linear between octaves (exact at
 /// powers of two, at most 16 · 0.0861 = 1.38 codes below, then floored: within 2.4
 /// codes; monotone, 0 at 0).
-pub fn log_code(v: u32) -> i32 {
-    let x = u64::from(v) + 1;
+pub const fn log_code(v: u32) -> i32 {
+    let x = v as u64 + 1;
     let l = 63 - x.leading_zeros();
     let frac = ((x << 4) >> l) as i32 - 16;
     (16 * l) as i32 + frac

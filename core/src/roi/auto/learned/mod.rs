@@ -819,12 +819,13 @@ fn classify_cells<C: FrameCapacity>(
         code(cx, cy, &feats)
     };
     // `labels8` (the marks) and `dilated4` (the worklist) are free until stage 4.
+    let rule = prescreen::SeedRule::new(&lv);
     prescreen::cascade(
         plane,
         work.labels4.as_mut(),
         work.labels8.as_mut(),
         work.dilated4.as_mut(),
-        |cx, cy| !screen || prescreen::is_seed(mean_dn, step_code, ints.sum, plane, &lv, (cx, cy)),
+        |cx, cy| !screen || rule.is_seed(mean_dn, step_code, ints.sum, plane, (cx, cy)),
         classify,
     );
 }
@@ -1894,7 +1895,7 @@ mod tests {
         assert!(at((2, 25))[o + 1] < -log_code(4 * 100), "{:?}", at((2, 25)));
     }
 
-    /// The pre-screen's seed rule on the planes (`prescreen::is_seed`, what the detector
+    /// The pre-screen's seed rule on the planes (`prescreen::SeedRule`, what the detector
     /// runs) equals the rule on the cell's features (`is_seed_features`, what the checks
     /// on feature dumps use), on textured frames at three bit depths; and the detector
     /// with the cascade finds the same box as the full pass on them.
@@ -1910,14 +1911,14 @@ mod tests {
                 want.push(prescreen::is_seed_features(f))
             });
             let (plane, lv) = prepare(&frame, &mut work, Window::full(&frame));
+            let rule = prescreen::SeedRule::new(&lv);
             for cy in 0..plane.1 {
                 for cx in 0..plane.0 {
-                    let got = prescreen::is_seed(
+                    let got = rule.is_seed(
                         work.mean_dn.as_ref(),
                         work.step_code.as_ref(),
                         work.sum.as_ref(),
                         plane,
-                        &lv,
                         (cx, cy),
                     );
                     assert_eq!(got, want[cy * plane.0 + cx], "({cx}, {cy}) seed {seed}");

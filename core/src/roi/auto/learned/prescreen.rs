@@ -3,7 +3,7 @@
 //!
 //! Two steps ([`cascade`]):
 //! 1. **Seeds**, a cheap look at each 8×8 cell from the cell planes alone (no pixel
-//!    read, [`is_seed`]): a cell is a seed when it has an outline or a level of its
+//!    read, [`SeedRule::is_seed`]): a cell is a seed when it has an outline or a level of its
 //!    own: its largest two-pixel step reaches [`SEED_STEP_CODE_MIN`], its mean
 //!    differs from the mean of one of its context boxes (radii
 //!    [`super::features::RADII_CELLS`]) by at least [`SEED_CONTRAST_CODE_MIN`], or
@@ -24,7 +24,6 @@
 //! the forest is retrained).
 
 use super::features::{FEATURES, FrameLevels, RADII_CELLS, log_code};
-use super::narrow::{div_i64, div_u64};
 
 /// A cell whose largest two-pixel step reaches this [`log_code`] (of 4 · step / σ;
 /// feature 3) is a seed. 90: a step of about 13 σ (`log_code(52) = 90`); a noise
@@ -44,56 +43,104 @@ pub const SEED_CONTRAST_CODE_MIN: i32 = 70;
 /// the frame, whatever its surroundings).
 pub const SEED_LEVEL_MIN: i32 = 96;
 
-/// Whether cell `(cx, cy)` of a `pw × ph` plane is a seed (see the module).
-/// `mean_dn`, `step_code`: the cell planes ([`super::cells::fill_cells`]); `sum`: the
-/// integral plane of `mean_dn` ([`super::features::integrate`]). A cell outside the
-/// plane reads as 0 (no panic path).
-pub fn is_seed(
-    mean_dn: &[u16],
-    step_code: &[u8],
-    sum: &[u32],
-    (pw, ph): (usize, usize),
-    lv: &FrameLevels,
-    (cx, cy): (usize, usize),
-) -> bool {
-    let i = cy * pw + cx;
-    if i32::from(step_code.get(i).copied().unwrap_or(0)) >= SEED_STEP_CODE_MIN {
-        return true;
+/// The least `q` whose [`log_code`] reaches [`SEED_CONTRAST_CODE_MIN`] (21: a contrast
+/// of 5.25 σ): the contrast test as `4 · |m − mean| / σ ≥ q`, without the log.
+const SEED_CONTRAST_Q_MIN: u64 = {
+    let mut q = 0u32;
+    while log_code(q) < SEED_CONTRAST_CODE_MIN {
+        q += 1;
     }
-    let m = u64::from(mean_dn.get(i).copied().unwrap_or(0));
-    // Feature 0's magnitude (the same arithmetic as `cell_features`).
-    let range = i64::from(lv.p98.saturating_sub(lv.p2)).max(i64::from(lv.sigma.max(1)));
-    let level = div_i64((m as i64 - i64::from(lv.p50)) * 256, range).clamp(-4096, 4096);
-    if level.abs() >= i64::from(SEED_LEVEL_MIN) {
-        return true;
-    }
-    let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
-        (Some(x), Some(y)) => u64::from(sum.get(y * pw + x).copied().unwrap_or(0)),
-        _ => 0,
-    };
-    let sigma = u64::from(lv.sigma.max(1));
-    for &r in RADII_CELLS.iter() {
-        let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
-        let (x1, y1) = (
-            (cx + r).min(pw.saturating_sub(1)),
-            (cy + r).min(ph.saturating_sub(1)),
-        );
-        let n = ((x1 + 1).saturating_sub(x0) * (y1 + 1).saturating_sub(y0)) as u64;
-        let (xa, ya) = (x0.checked_sub(1), y0.checked_sub(1));
-        let s = (at(Some(x1), Some(y1)) + at(xa, ya))
-            .saturating_sub(at(xa, Some(y1)) + at(Some(x1), ya));
-        let mean = div_u64(s, n.max(1));
-        let q = div_u64(m.abs_diff(mean) * 4, sigma).min(u64::from(u32::MAX)) as u32;
-        if log_code(q) >= SEED_CONTRAST_CODE_MIN {
-            return true;
-        }
-    }
-    false
+    q as u64
+};
+
+/// The seed rule for one frame (see the module): the thresholds of the level
+/// and contrast tests turned into DN once per frame, so that a cell's look multiplies
+/// and compares but never divides (four box means and a level, each a division, cost
+/// the M7 about 350 instructions per cell, 0.72 M per frame; the decisions are the
+/// same, bit for bit: tested against the divisions and against [`is_seed_features`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SeedRule {
+    /// The frame's median cell mean, DN (feature 0's origin).
+    p50: u64,
+    /// `SEED_LEVEL_MIN · max(p98 − p2, σ)`: a cell is a level seed when `256 · |m − p50|`
+    /// reaches it (feature 0 rounds toward zero, so `|level| ≥ 96` exactly then).
+    level_x256: u64,
+    /// `⌈SEED_CONTRAST_Q_MIN · σ / 4⌉`, DN: a cell is a contrast seed when its mean and a
+    /// context box's (rounded down, as feature 5 + 4k takes it) differ by at least this
+    /// (`⌊4 d / σ⌋ ≥ q` exactly when `4 d ≥ q σ`).
+    contrast_dn: u32,
 }
 
-/// [`is_seed`] on a cell's feature vector ([`super::features::cell_features`]): feature
+/// A contrast bound no cell mean reaches (means are u16): [`SeedRule::is_seed`]'s clamp.
+const ABOVE_ANY_MEAN: u32 = 1 << 16;
+
+impl SeedRule {
+    /// The rule for a frame of levels `lv`.
+    pub fn new(lv: &FrameLevels) -> Self {
+        let sigma = u64::from(lv.sigma.max(1));
+        let range = u64::from(lv.p98.saturating_sub(lv.p2)).max(sigma);
+        Self {
+            p50: u64::from(lv.p50),
+            level_x256: SEED_LEVEL_MIN as u64 * range,
+            contrast_dn: (SEED_CONTRAST_Q_MIN * sigma)
+                .div_ceil(4)
+                .min(u64::from(ABOVE_ANY_MEAN)) as u32,
+        }
+    }
+
+    /// Whether cell `(cx, cy)` of a `pw × ph` plane is a seed (see the module).
+    /// `mean_dn`, `step_code`: the cell planes ([`super::cells::fill_cells`]); `sum`:
+    /// the integral plane of `mean_dn` ([`super::features::integrate`]). A cell outside
+    /// the plane reads as 0 (no panic path).
+    pub fn is_seed(
+        &self,
+        mean_dn: &[u16],
+        step_code: &[u8],
+        sum: &[u32],
+        (pw, ph): (usize, usize),
+        (cx, cy): (usize, usize),
+    ) -> bool {
+        let i = cy * pw + cx;
+        if i32::from(step_code.get(i).copied().unwrap_or(0)) >= SEED_STEP_CODE_MIN {
+            return true;
+        }
+        let m = u64::from(mean_dn.get(i).copied().unwrap_or(0));
+        if 256 * m.abs_diff(self.p50) >= self.level_x256 {
+            return true;
+        }
+        // In 32 bits, exactly: a box sum of n cell means is at most n · 65 535, so a
+        // bound above 65 535 cannot be reached and is clamped to 65 536 (n ≤ 17² cells:
+        // 65 536 · n fits).
+        let m = m as u32;
+        let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
+            (Some(x), Some(y)) => sum.get(y * pw + x).copied().unwrap_or(0),
+            _ => 0,
+        };
+        // ⌊s/n⌋ ≥ m + t ⇔ s ≥ (m + t)·n; ⌊s/n⌋ ≤ m − t ⇔ s < (m − t + 1)·n.
+        let above = (m + self.contrast_dn).min(ABOVE_ANY_MEAN);
+        let below = m.checked_sub(self.contrast_dn);
+        for &r in RADII_CELLS.iter() {
+            let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
+            let (x1, y1) = (
+                (cx + r).min(pw.saturating_sub(1)),
+                (cy + r).min(ph.saturating_sub(1)),
+            );
+            let n = ((x1 + 1).saturating_sub(x0) * (y1 + 1).saturating_sub(y0)).max(1) as u32;
+            let (xa, ya) = (x0.checked_sub(1), y0.checked_sub(1));
+            // Modulo 2³², exact: the box sum itself is under 2³².
+            let s = (at(Some(x1), Some(y1)).wrapping_add(at(xa, ya)))
+                .wrapping_sub(at(xa, Some(y1)).wrapping_add(at(Some(x1), ya)));
+            if s >= above.wrapping_mul(n) || below.is_some_and(|b| s < (b + 1).wrapping_mul(n)) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// [`SeedRule::is_seed`] on a cell's feature vector ([`super::features::cell_features`]): feature
 /// 3 against [`SEED_STEP_CODE_MIN`], the magnitudes of features 5, 9, 13, 17 against
-/// [`SEED_CONTRAST_CODE_MIN`] and of feature 0 against [`SEED_LEVEL_MIN`]. The same decision as [`is_seed`] on the planes (tested),
+/// [`SEED_CONTRAST_CODE_MIN`] and of feature 0 against [`SEED_LEVEL_MIN`]. The same decision as [`SeedRule::is_seed`] on the planes (tested),
 /// for checks on feature dumps.
 pub fn is_seed_features(f: &[i32; FEATURES]) -> bool {
     f[3] >= SEED_STEP_CODE_MIN
@@ -104,7 +151,7 @@ pub fn is_seed_features(f: &[i32; FEATURES]) -> bool {
 /// The cascade over a `pw × ph` plane (see the module): `codes[i]` ends as
 /// `classify(cx, cy)` for every classified cell and 0 for the others; `marks` (one
 /// byte per cell) records which were classified (1) and `stack` (two bytes per cell)
-/// holds the worklist. `seed(cx, cy)`: [`is_seed`] in the detector, `|_, _| true` to
+/// holds the worklist. `seed(cx, cy)`: [`SeedRule::is_seed`] in the detector, `|_, _| true` to
 /// classify every cell. Returns the number of cells classified. With buffers shorter
 /// than the plane (never, by the caller's sizes) every cell is classified: the full
 /// pass, no panic path.
@@ -311,6 +358,89 @@ mod tests {
             assert_eq!((all, calls), (n, n));
             assert_eq!(codes, full);
         }
+    }
+
+    /// [`SeedRule::is_seed`] (no division) against the rule as the features state it,
+    /// by brute force: box means summed cell by cell and divided, the contrast's and the
+    /// level's codes through [`log_code`] and a division rounded toward zero. Random
+    /// planes whose means sit near the thresholds (a few σ of spread, σ 1–30 000 DN,
+    /// means up to 65 535), steps under the step threshold.
+    #[test]
+    fn seed_rule_without_division_equals_the_features_rule() {
+        let mut s = 0x0bad_5eedu32;
+        let (mut seeds, mut cells) = (0usize, 0usize);
+        for _ in 0..400 {
+            let pw = 1 + (xorshift(&mut s) % 24) as usize;
+            let ph = 1 + (xorshift(&mut s) % 20) as usize;
+            // One plane in eight with a σ of thousands of DN and means up to the top
+            // of u16 (the 32-bit clamps), the others σ 1–40 DN.
+            let sigma = 1 + xorshift(&mut s)
+                % if xorshift(&mut s) % 8 == 0 {
+                    30_000
+                } else {
+                    40
+                };
+            let spread = 1 + xorshift(&mut s) % (12 * sigma).min(60_000);
+            let base = xorshift(&mut s) % (65_536 - spread);
+            let mean_dn: Vec<u16> = (0..pw * ph)
+                .map(|_| (base + xorshift(&mut s) % spread) as u16)
+                .collect();
+            let step_code: Vec<u8> = (0..pw * ph)
+                .map(|_| (xorshift(&mut s) % SEED_STEP_CODE_MIN as u32) as u8)
+                .collect();
+            let mut sum = std::vec![0u32; pw * ph];
+            for cy in 0..ph {
+                for cx in 0..pw {
+                    sum[cy * pw + cx] = (0..=cy)
+                        .flat_map(|y| (0..=cx).map(move |x| (x, y)))
+                        .map(|(x, y)| u32::from(mean_dn[y * pw + x]))
+                        .sum();
+                }
+            }
+            let mut sorted = mean_dn.clone();
+            sorted.sort_unstable();
+            let p50 = sorted[xorshift(&mut s) as usize % sorted.len()];
+            let (p2, p98) = (sorted[0], sorted[sorted.len() - 1]);
+            let lv = FrameLevels {
+                p2,
+                p50,
+                p98,
+                sigma,
+                sd_shift: 0,
+                max_dn: u16::MAX,
+                step_rank_code: 0,
+            };
+            let rule = SeedRule::new(&lv);
+            let range = i64::from(p98 - p2).max(i64::from(sigma));
+            for cy in 0..ph {
+                for cx in 0..pw {
+                    let m = i64::from(mean_dn[cy * pw + cx]);
+                    let level = ((m - i64::from(p50)) * 256 / range).clamp(-4096, 4096);
+                    let mut want = level.abs() >= i64::from(SEED_LEVEL_MIN);
+                    for &r in RADII_CELLS.iter() {
+                        let (mut total, mut n) = (0i64, 0i64);
+                        for y in cy.saturating_sub(r)..=(cy + r).min(ph - 1) {
+                            for x in cx.saturating_sub(r)..=(cx + r).min(pw - 1) {
+                                total += i64::from(mean_dn[y * pw + x]);
+                                n += 1;
+                            }
+                        }
+                        let d = (m - total / n).unsigned_abs();
+                        let q = (d * 4 / u64::from(sigma)).min(u64::from(u32::MAX)) as u32;
+                        want |= log_code(q) >= SEED_CONTRAST_CODE_MIN;
+                    }
+                    let got = rule.is_seed(&mean_dn, &step_code, &sum, (pw, ph), (cx, cy));
+                    assert_eq!(got, want, "{pw}x{ph} ({cx}, {cy}) sigma {sigma}");
+                    seeds += usize::from(got);
+                    cells += 1;
+                }
+            }
+        }
+        // Both answers are common: the thresholds are crossed, not avoided.
+        assert!(
+            seeds > cells / 10 && seeds < cells * 9 / 10,
+            "{seeds} of {cells}"
+        );
     }
 
     /// Buffers shorter than the plane: every cell classified (the full pass), no panic.
