@@ -44,7 +44,8 @@ use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, rated_spots,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, DEEP_SPACE_SCORE_PERMILLE, for_each_cell_features,
+    rated_spots,
 };
 use tirroi_host::imaging::image_io::read_frame;
 
@@ -239,7 +240,7 @@ fn main() {
                 }
                 match scratch.work().blob() {
                     Some(b) => {
-                        let _ = writeln!(
+                        let _ = write!(
                             s,
                             ",{},{},{},{},{},{}",
                             b.saturated_px,
@@ -250,8 +251,23 @@ fn main() {
                             b.score_permille()
                         );
                     }
-                    None => s.push_str(",,,,,,\n"),
+                    None => s.push_str(",,,,,,"),
                 }
+                // The stage whose box this is (what the score's scale is).
+                let work = scratch.work();
+                let stage = match d.roi {
+                    None => "none",
+                    Some(r) if work.spot().is_some_and(|(b, _)| b == r) => "spot",
+                    Some(_) if work.blob_won() => "blob",
+                    Some(_)
+                        if work.deep_space().is_some()
+                            && d.score_permille == DEEP_SPACE_SCORE_PERMILLE =>
+                    {
+                        "deep-space"
+                    }
+                    Some(_) => "classifier",
+                };
+                let _ = writeln!(s, ",{stage}");
             }
             s
         })
@@ -271,7 +287,7 @@ fn main() {
     } else {
         "file,x0,y0,x1,y1,score,cells,box_w,box_h,sides,code_sum,code_max,components,runner_up,\
              perimeter,contrast_code,clutter_code,edge_sides,reach,spans,spread_code,step_mean_code,\
-             interior_cells,interior_step_code,rough,blob_px,blob_solid,blob_ring,blob_other,blob_sides,blob_score"
+             interior_cells,interior_step_code,rough,blob_px,blob_solid,blob_ring,blob_other,blob_sides,blob_score,stage"
             .to_string()
     };
     std::fs::write(&out, format!("{header}\n{}", lines.concat())).expect("write");
