@@ -78,7 +78,11 @@ pub struct AutoV2 {
     /// stay ≤ 2 % on the no-target frames of every kind (realistic 1 of 60, fixtures 0
     /// of 80; 500: realistic 2 of 60). Re-chosen by the same rule for session 26's
     /// refitted confidence: 550 again (realistic 1 of 60, its second-highest no-target
-    /// winner at 525; fixtures' highest 489).
+    /// winner at 525; fixtures' highest 489). Since family A has 300 more realistic
+    /// frames without a target (famAE, session 33) no gate up to 650 meets the rule
+    /// there; kept at 550 as the trade-off, measured for session 39's confidence
+    /// (`docs/detectors.md` § Session 39: 500 / 550 / 600 / 650 → family A 2.440 /
+    /// 2.418 / 2.379 / 2.355, famAE8 18 / 14 / 12 / 10 of 300).
     pub min_score_permille: u16,
     /// A box that is a saturated blob is cut by this many pixels per side (off the
     /// frame's edges; [`saturated`]), px: 0..=8. A property of the camera: the reach of
