@@ -44,8 +44,7 @@ use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, DEEP_SPACE_SCORE_PERMILLE, for_each_cell_features,
-    rated_spots,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, rated_spots,
 };
 use tirroi_host::imaging::image_io::read_frame;
 
@@ -253,18 +252,15 @@ fn main() {
                     }
                     None => s.push_str(",,,,,,"),
                 }
-                // The stage whose box this is (what the score's scale is).
+                // The stage whose box this is (what the score's scale is): the work's
+                // telemetry is set only by the stage that answered (`deep_space()`:
+                // stage 2c, or 2d when on).
                 let work = scratch.work();
                 let stage = match d.roi {
                     None => "none",
                     Some(r) if work.spot().is_some_and(|(b, _)| b == r) => "spot",
                     Some(_) if work.blob_won() => "blob",
-                    Some(_)
-                        if work.deep_space().is_some()
-                            && d.score_permille == DEEP_SPACE_SCORE_PERMILLE =>
-                    {
-                        "deep-space"
-                    }
+                    Some(_) if work.deep_space().is_some() => "deep-space",
                     Some(_) => "classifier",
                 };
                 let _ = writeln!(s, ",{stage}");
