@@ -20,7 +20,8 @@
 #                                                 whose folder exists; ~3 min on 2 cores)
 #        scripts/families.sh eval DIR [TIRROI]   `tirroi eval --method auto-v2` on each set,
 #                                                 both truth conventions: one row per set
-#                                                 and family A's summed mean IoU (½)
+#                                                 and family A's summed mean IoU (½), then
+#                                                 each set's table rows (mode × range)
 # TIRROI: the binary to score (default target/release/tirroi, built if missing).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -99,6 +100,18 @@ case $cmd in
             fi
         done
         printf '\nfamily A sum (famA + paperA + fixA + famAF, mean IoU ½): %s\n' "$sum"
+        # The paper's table rows (mode × range, eval's `row` group) of the sets that
+        # have them: where a change moved a set's figure.
+        printf '\n| set | row | frames with a target | mean IoU ½ | false alarms |\n'
+        printf '|---|---|---|---|---|\n'
+        for name in "${family_a[@]}" "${held_out[@]}"; do
+            awk -F, -v set="$name" '$2 == "row" {
+                empty = $4 - $10
+                fa = (empty > 0) ? sprintf("%d / %d", $11 * empty + 0.5, empty) : "–"
+                iou = ($10 > 0) ? $5 : "–"
+                printf "| %s | %s | %s | %s | %s |\n", set, $3, $10, iou, fa
+            }' "$out/$name/summary.csv"
+        done
         ;;
     *) die "unknown command $cmd (render or eval)" ;;
 esac

@@ -143,6 +143,7 @@ fn write_dataset(dir: &Path, n: usize) -> Vec<TruthRow> {
             groups: vec![
                 ("mode".into(), "radiometry".into()),
                 ("range".into(), "close".into()),
+                ("row".into(), "radiometry close".into()),
             ],
             range_m: Some(20.0 + i as f64),
             bits: None,

@@ -172,6 +172,16 @@ pub fn range_band(range_m: f64) -> &'static str {
     }
 }
 
+/// The row of the paper's tables a frame belongs to, the group key `row`: its mode and
+/// range band, e.g. `radiometry close` (Table 6), `detection close` (Table 7),
+/// `radiometry far`; `None` unless both `mode` and `range` are among `groups`. The
+/// marginal groups alone cannot give a row's figure (close range holds both modes), and
+/// issue 16 scores `auto-v2` per row.
+pub fn table_row(groups: &[(String, String)]) -> Option<String> {
+    let of = |key: &str| groups.iter().find(|(k, _)| k == key).map(|(_, v)| v);
+    Some(format!("{} {}", of("mode")?, of("range")?))
+}
+
 /// Reads `truth.csv`, scoring against the `x0,y0,x1,y1` box ([`TruthCoverage::Half`]).
 ///
 /// # Errors
@@ -349,6 +359,13 @@ pub fn read_truth_lines(
     }
     if !header.contains(&"signal_to_clutter") {
         scr_from_metadata(path, rows.iter_mut().map(|(_, r)| r));
+    }
+    // Last, whatever gave the other groups: the same order with or without the
+    // `signal_to_clutter` column.
+    for (_, r) in &mut rows {
+        if let Some(row) = table_row(&r.groups) {
+            r.groups.push(("row".into(), row));
+        }
     }
     Ok(rows)
 }
@@ -975,6 +992,24 @@ mod tests {
         assert_eq!(scr_bin(1.0), "1-3");
         assert_eq!(scr_bin(9.99), "3-10");
         assert_eq!(scr_bin(10.0), ">=10");
+    }
+
+    #[test]
+    fn table_rows_cross_mode_and_range() {
+        let g = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        };
+        let both = g(&[("mode", "radiometry"), ("scale", "2"), ("range", "close")]);
+        assert_eq!(table_row(&both).as_deref(), Some("radiometry close"));
+        assert_eq!(
+            table_row(&g(&[("range", "far"), ("mode", "detection")])).as_deref(),
+            Some("detection far")
+        );
+        assert_eq!(table_row(&g(&[("mode", "detection")])), None);
+        assert_eq!(table_row(&g(&[("range", "mid")])), None);
     }
 
     #[test]
