@@ -22,17 +22,32 @@
 #                                                 both truth conventions: one row per set
 #                                                 and family A's summed mean IoU (½), then
 #                                                 each set's table rows (mode × range)
+#        scripts/families.sh compare DIR A B     two binaries side by side (½ convention):
+#                                                 each set's mean IoU and false alarms under
+#                                                 A and B with the change, family A's and
+#                                                 the held-out sets' summed change, and the
+#                                                 table rows that moved (a candidate is
+#                                                 chosen by family A; the held-out sum and
+#                                                 false alarms are the drop to report)
 # TIRROI: the binary to score (default target/release/tirroi, built if missing).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 die() { echo "families: $*" >&2; exit 2; }
-[[ $# -ge 2 ]] || die "usage: scripts/families.sh render|eval DIR [TIRROI]"
+[[ $# -ge 2 ]] || die "usage: scripts/families.sh render|eval DIR [TIRROI] | compare DIR A B"
 cmd=$1
 dir=$2
-tirroi=${3:-$root/target/release/tirroi}
-if [[ ! -x $tirroi ]]; then
-    [[ $# -ge 3 ]] && die "$tirroi is not an executable"
-    (cd "$root" && cargo build --release --quiet --bin tirroi)
+if [[ $cmd == compare ]]; then
+    [[ $# -eq 4 ]] || die "usage: scripts/families.sh compare DIR A B (two tirroi binaries)"
+    for bin in "$3" "$4"; do
+        [[ -x $bin ]] || die "$bin is not an executable"
+    done
+    tirroi=$3
+else
+    tirroi=${3:-$root/target/release/tirroi}
+    if [[ ! -x $tirroi ]]; then
+        [[ $# -ge 3 ]] && die "$tirroi is not an executable"
+        (cd "$root" && cargo build --release --quiet --bin tirroi)
+    fi
 fi
 
 family_a=(famA paperA fixA famAF famAE famAT)
@@ -113,5 +128,66 @@ case $cmd in
             }' "$out/$name/summary.csv"
         done
         ;;
-    *) die "unknown command $cmd (render or eval)" ;;
+    compare)
+        [[ -d $dir ]] || die "no folder $dir (run: scripts/families.sh render $dir)"
+        out="$(mktemp -d)"
+        trap 'rm -rf "$out"' EXIT
+        for side in a b; do
+            bin=$3
+            [[ $side == b ]] && bin=$4
+            for name in "${family_a[@]}" "${held_out[@]}"; do
+                [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
+                "$bin" eval --images "$dir/$name" --method auto-v2 --repeat 1 \
+                    --out "$out/$side/$name" >/dev/null
+            done
+        done
+        # summary.csv: method,group,value,frames,mean_iou,...,target_frames (10),
+        # false_alarm_rate (11). One line per set: targets, IoU and false alarms of A, B.
+        fields() {
+            awk -F, -v g="$2" -v v="$3" '$2 == g && $3 == v {
+                empty = $4 - $10
+                printf "%s %s %d %d", $10, $5, $11 * empty + 0.5, empty
+            }' "$1"
+        }
+        printf '| set | role | frames with a target | A mean IoU ½ | B mean IoU ½ | change | A false alarms | B false alarms |\n'
+        printf '|---|---|---|---|---|---|---|---|\n'
+        sum_a=0 sum_h=0
+        for name in "${family_a[@]}" "${held_out[@]}"; do
+            role="held out"
+            [[ " ${family_a[*]} " == *" $name "* ]] && role="family A"
+            read -r targets iou_a fa_a empty <<<"$(fields "$out/a/$name/summary.csv" all all)"
+            read -r _ iou_b fa_b _ <<<"$(fields "$out/b/$name/summary.csv" all all)"
+            if [[ $targets -gt 0 ]]; then
+                delta=$(awk -v a="$iou_a" -v b="$iou_b" 'BEGIN { printf "%+.4f", b - a }')
+                if [[ $role == "family A" && $name != famAT ]]; then
+                    sum_a=$(awk -v s="$sum_a" -v d="$delta" 'BEGIN { printf "%+.4f", s + d }')
+                elif [[ $role == "held out" ]]; then
+                    sum_h=$(awk -v s="$sum_h" -v d="$delta" 'BEGIN { printf "%+.4f", s + d }')
+                fi
+            else
+                iou_a="–" iou_b="–" delta="–"
+            fi
+            fa_a_text="–" fa_b_text="–"
+            [[ $empty -gt 0 ]] && { fa_a_text="$fa_a / $empty"; fa_b_text="$fa_b / $empty"; }
+            printf '| %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$role" "$targets" \
+                "$iou_a" "$iou_b" "$delta" "$fa_a_text" "$fa_b_text"
+        done
+        printf '\nchange of family A sum (famA + paperA + fixA + famAF): %s\n' "$sum_a"
+        printf 'change summed over the held-out sets: %s\n' "$sum_h"
+        printf '\n| set | row | A mean IoU ½ | B mean IoU ½ | A false alarms | B false alarms |\n'
+        printf '|---|---|---|---|---|---|\n'
+        for name in "${family_a[@]}" "${held_out[@]}"; do
+            awk -F, '$2 == "row" { print $3 }' "$out/a/$name/summary.csv" | while read -r row; do
+                read -r targets iou_a fa_a empty <<<"$(fields "$out/a/$name/summary.csv" row "$row")"
+                read -r _ iou_b fa_b _ <<<"$(fields "$out/b/$name/summary.csv" row "$row")"
+                [[ $iou_a == "$iou_b" && $fa_a == "$fa_b" ]] && continue
+                [[ $targets -gt 0 ]] || { iou_a="–"; iou_b="–"; }
+                fa_a_text="–" fa_b_text="–"
+                [[ $empty -gt 0 ]] && { fa_a_text="$fa_a / $empty"; fa_b_text="$fa_b / $empty"; }
+                printf '| %s | %s | %s | %s | %s | %s |\n' "$name" "$row" \
+                    "$iou_a" "$iou_b" "$fa_a_text" "$fa_b_text"
+            done
+        done
+        ;;
+    *) die "unknown command $cmd (render, eval or compare)" ;;
 esac
