@@ -53,6 +53,41 @@ fi
 family_a=(famA paperA fixA famAF famAE famAT)
 held_out=(famB famBT paperB ts-fixtures ts-dark ts-real-earth)
 
+# "family A" or "held out": the set's role in a choice.
+role_of() {
+    if [[ " ${family_a[*]} " == *" $1 "* ]]; then echo "family A"; else echo "held out"; fi
+}
+
+# `tirroi eval --method auto-v2` of binary BIN on every set into OUT/<set>; further
+# arguments go to eval (e.g. --truth-coverage quarter).
+score_sets() {
+    local bin=$1 into=$2 name
+    shift 2
+    [[ -d $dir ]] || die "no folder $dir (run: scripts/families.sh render $dir)"
+    for name in "${family_a[@]}" "${held_out[@]}"; do
+        [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
+        "$bin" eval --images "$dir/$name" --method auto-v2 --repeat 1 \
+            --out "$into/$name" "$@" >/dev/null
+    done
+}
+
+# Of group GROUP = VALUE in eval's SUMMARY.csv (method,group,value,frames,mean_iou,
+# median_iou,hit_rate,mean_time_ms,median_time_ms,target_frames,false_alarm_rate,auc,
+# calibration_gap): frames with a target, mean IoU, false alarms, frames without a
+# target, AUC and calibration gap ("–" when empty), space-separated.
+fields() {
+    awk -F, -v g="$2" -v v="$3" '$2 == g && $3 == v {
+        empty = $4 - $10
+        printf "%s %s %d %d %s %s", $10, $5, $11 * empty + 0.5, empty,
+            ($12 == "" ? "–" : $12), ($13 == "" ? "–" : $13)
+    }' "$1"
+}
+
+# "FALSE_ALARMS / FRAMES_WITHOUT_TARGET", or "–" without such frames.
+fa_text() {
+    if [[ $2 -gt 0 ]]; then echo "$1 / $2"; else echo "–"; fi
+}
+
 render_set() {
     local name=$1
     shift
@@ -84,35 +119,26 @@ case $cmd in
         done
         ;;
     eval)
-        [[ -d $dir ]] || die "no folder $dir (run: scripts/families.sh render $dir)"
         out="$(mktemp -d)"
         trap 'rm -rf "$out"' EXIT
+        score_sets "$tirroi" "$out/half"
+        score_sets "$tirroi" "$out/quarter" --truth-coverage quarter
         printf '| set | role | frames with a target | mean IoU ½ / ¼ | false alarms | AUC | calibration gap |\n'
         printf '|---|---|---|---|---|---|---|\n'
         sum=0
         for name in "${family_a[@]}" "${held_out[@]}"; do
-            [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
-            role="held out"
-            [[ " ${family_a[*]} " == *" $name "* ]] && role="family A"
-            "$tirroi" eval --images "$dir/$name" --method auto-v2 --repeat 1 \
-                --out "$out/$name" >/dev/null
-            "$tirroi" eval --images "$dir/$name" --method auto-v2 --repeat 1 \
-                --truth-coverage quarter --out "$out/$name-q" >/dev/null 2>&1 || true
-            # summary.csv: method,group,value,frames,mean_iou,median_iou,hit_rate,
-            # mean_time_ms,median_time_ms,target_frames,false_alarm_rate,auc,calibration_gap
-            row=$(awk -F, '$2 == "all" {
-                empty = $4 - $10
-                fa = (empty > 0) ? sprintf("%d / %d", $11 * empty + 0.5, empty) : "–"
-                printf "%s|%s|%s|%s|%s", $10, $5, fa, ($12 == "" ? "–" : $12), ($13 == "" ? "–" : $13)
-            }' "$out/$name/summary.csv")
-            IFS='|' read -r targets iou fa auc gap <<<"$row"
-            quarter=$(awk -F, '$2 == "all" { print $5 }' "$out/$name-q/summary.csv" 2>/dev/null || true)
-            [[ $targets -gt 0 ]] || { iou="–"; quarter=""; }
-            printf '| %s | %s | %s | %s / %s | %s | %s | %s |\n' \
-                "$name" "$role" "$targets" "$iou" "${quarter:-–}" "$fa" "$auc" "$gap"
-            if [[ $role == "family A" && $targets -gt 0 && $name != famAT ]]; then
-                sum=$(awk -v a="$sum" -v b="$iou" 'BEGIN { printf "%.4f", a + b }')
+            role=$(role_of "$name")
+            read -r targets iou fa empty auc gap <<<"$(fields "$out/half/$name/summary.csv" all all)"
+            read -r _ quarter _ <<<"$(fields "$out/quarter/$name/summary.csv" all all)"
+            if [[ $targets -gt 0 ]]; then
+                if [[ $role == "family A" && $name != famAT ]]; then
+                    sum=$(awk -v a="$sum" -v b="$iou" 'BEGIN { printf "%.4f", a + b }')
+                fi
+            else
+                iou="–" quarter="–"
             fi
+            printf '| %s | %s | %s | %s / %s | %s | %s | %s |\n' \
+                "$name" "$role" "$targets" "$iou" "$quarter" "$(fa_text "$fa" "$empty")" "$auc" "$gap"
         done
         printf '\nfamily A sum (famA + paperA + fixA + famAF, mean IoU ½): %s\n' "$sum"
         # The paper's table rows (mode × range, eval's `row` group) of the sets that
@@ -120,42 +146,26 @@ case $cmd in
         printf '\n| set | row | frames with a target | mean IoU ½ | false alarms |\n'
         printf '|---|---|---|---|---|\n'
         for name in "${family_a[@]}" "${held_out[@]}"; do
-            awk -F, -v set="$name" '$2 == "row" {
-                empty = $4 - $10
-                fa = (empty > 0) ? sprintf("%d / %d", $11 * empty + 0.5, empty) : "–"
-                iou = ($10 > 0) ? $5 : "–"
-                printf "| %s | %s | %s | %s | %s |\n", set, $3, $10, iou, fa
-            }' "$out/$name/summary.csv"
+            summary="$out/half/$name/summary.csv"
+            awk -F, '$2 == "row" { print $3 }' "$summary" | while read -r row; do
+                read -r targets iou fa empty _ <<<"$(fields "$summary" row "$row")"
+                [[ $targets -gt 0 ]] || iou="–"
+                printf '| %s | %s | %s | %s | %s |\n' \
+                    "$name" "$row" "$targets" "$iou" "$(fa_text "$fa" "$empty")"
+            done
         done
         ;;
     compare)
-        [[ -d $dir ]] || die "no folder $dir (run: scripts/families.sh render $dir)"
         out="$(mktemp -d)"
         trap 'rm -rf "$out"' EXIT
-        for side in a b; do
-            bin=$3
-            [[ $side == b ]] && bin=$4
-            for name in "${family_a[@]}" "${held_out[@]}"; do
-                [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
-                "$bin" eval --images "$dir/$name" --method auto-v2 --repeat 1 \
-                    --out "$out/$side/$name" >/dev/null
-            done
-        done
-        # summary.csv: method,group,value,frames,mean_iou,...,target_frames (10),
-        # false_alarm_rate (11). One line per set: targets, IoU and false alarms of A, B.
-        fields() {
-            awk -F, -v g="$2" -v v="$3" '$2 == g && $3 == v {
-                empty = $4 - $10
-                printf "%s %s %d %d", $10, $5, $11 * empty + 0.5, empty
-            }' "$1"
-        }
+        score_sets "$3" "$out/a"
+        score_sets "$4" "$out/b"
         printf '| set | role | frames with a target | A mean IoU ½ | B mean IoU ½ | change | A false alarms | B false alarms |\n'
         printf '|---|---|---|---|---|---|---|---|\n'
         sum_a=0 sum_h=0
         for name in "${family_a[@]}" "${held_out[@]}"; do
-            role="held out"
-            [[ " ${family_a[*]} " == *" $name "* ]] && role="family A"
-            read -r targets iou_a fa_a empty <<<"$(fields "$out/a/$name/summary.csv" all all)"
+            role=$(role_of "$name")
+            read -r targets iou_a fa_a empty _ <<<"$(fields "$out/a/$name/summary.csv" all all)"
             read -r _ iou_b fa_b _ <<<"$(fields "$out/b/$name/summary.csv" all all)"
             if [[ $targets -gt 0 ]]; then
                 delta=$(awk -v a="$iou_a" -v b="$iou_b" 'BEGIN { printf "%+.4f", b - a }')
@@ -167,25 +177,22 @@ case $cmd in
             else
                 iou_a="–" iou_b="–" delta="–"
             fi
-            fa_a_text="–" fa_b_text="–"
-            [[ $empty -gt 0 ]] && { fa_a_text="$fa_a / $empty"; fa_b_text="$fa_b / $empty"; }
             printf '| %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$role" "$targets" \
-                "$iou_a" "$iou_b" "$delta" "$fa_a_text" "$fa_b_text"
+                "$iou_a" "$iou_b" "$delta" "$(fa_text "$fa_a" "$empty")" "$(fa_text "$fa_b" "$empty")"
         done
         printf '\nchange of family A sum (famA + paperA + fixA + famAF): %s\n' "$sum_a"
         printf 'change summed over the held-out sets: %s\n' "$sum_h"
         printf '\n| set | row | A mean IoU ½ | B mean IoU ½ | A false alarms | B false alarms |\n'
         printf '|---|---|---|---|---|---|\n'
         for name in "${family_a[@]}" "${held_out[@]}"; do
-            awk -F, '$2 == "row" { print $3 }' "$out/a/$name/summary.csv" | while read -r row; do
-                read -r targets iou_a fa_a empty <<<"$(fields "$out/a/$name/summary.csv" row "$row")"
+            summary="$out/a/$name/summary.csv"
+            awk -F, '$2 == "row" { print $3 }' "$summary" | while read -r row; do
+                read -r targets iou_a fa_a empty _ <<<"$(fields "$summary" row "$row")"
                 read -r _ iou_b fa_b _ <<<"$(fields "$out/b/$name/summary.csv" row "$row")"
                 [[ $iou_a == "$iou_b" && $fa_a == "$fa_b" ]] && continue
                 [[ $targets -gt 0 ]] || { iou_a="–"; iou_b="–"; }
-                fa_a_text="–" fa_b_text="–"
-                [[ $empty -gt 0 ]] && { fa_a_text="$fa_a / $empty"; fa_b_text="$fa_b / $empty"; }
                 printf '| %s | %s | %s | %s | %s | %s |\n' "$name" "$row" \
-                    "$iou_a" "$iou_b" "$fa_a_text" "$fa_b_text"
+                    "$iou_a" "$iou_b" "$(fa_text "$fa_a" "$empty")" "$(fa_text "$fa_b" "$empty")"
             done
         done
         ;;
