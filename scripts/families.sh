@@ -28,7 +28,9 @@
 #                                                 the held-out sets' summed change, and the
 #                                                 table rows that moved (a candidate is
 #                                                 chosen by family A; the held-out sum and
-#                                                 false alarms are the drop to report)
+#                                                 false alarms are the drop to report);
+#                                                 further arguments go to every eval
+#                                                 (e.g. --track jitter)
 # TIRROI: the binary to score (default target/release/tirroi, built if missing).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -37,7 +39,7 @@ die() { echo "families: $*" >&2; exit 2; }
 cmd=$1
 dir=$2
 if [[ $cmd == compare ]]; then
-    [[ $# -eq 4 ]] || die "usage: scripts/families.sh compare DIR A B (two tirroi binaries)"
+    [[ $# -ge 4 ]] || die "usage: scripts/families.sh compare DIR A B [EVAL ARGS] (two tirroi binaries)"
     for bin in "$3" "$4"; do
         [[ -x $bin ]] || die "$bin is not an executable"
     done
@@ -158,8 +160,8 @@ case $cmd in
     compare)
         out="$(mktemp -d)"
         trap 'rm -rf "$out"' EXIT
-        score_sets "$3" "$out/a"
-        score_sets "$4" "$out/b"
+        score_sets "$3" "$out/a" "${@:5}"
+        score_sets "$4" "$out/b" "${@:5}"
         printf '| set | role | frames with a target | A mean IoU ½ | B mean IoU ½ | change | A false alarms | B false alarms |\n'
         printf '|---|---|---|---|---|---|---|---|\n'
         sum_a=0 sum_h=0

@@ -354,13 +354,15 @@ fn detect_budget_stops_auto_and_says_where() {
 }
 
 /// `detect --prior` hands the trackers (`auto`, `auto-v2`) the box of the frame
-/// before, and `--track` chains each tracker's own box from file to file: the boxes
+/// before, and `--track` chains each tracker's own box (and `auto-v2`'s look of it)
+/// from file to file: the boxes
 /// are the library's with those priors; the other methods ignore them; a reversed
 /// prior is one error line and exit code 2.
 #[test]
 fn detect_prior_and_track_are_the_library_trackers() {
     use tirroi::core::Detector;
     use tirroi::core::roi::auto::Auto;
+    use tirroi::core::roi::auto::learned::look::Look;
     use tirroi::core::roi::auto::learned::{AutoV2, AutoV2Scratch};
     let dir = fixtures();
     let file = dir.path().join("earth.png");
@@ -372,8 +374,9 @@ fn detect_prior_and_track_are_the_library_trackers() {
         saturated_erode_px: 0,
         ..AutoV2::default()
     };
-    let with = |p: Option<Roi>| {
+    let with = |p: Option<Roi>, look: Option<Look>| {
         v2.with_prior(p)
+            .with_look(look)
             .detect(&frame, &mut Box::new(AutoV2Scratch::new()))
             .expect("valid parameters")
             .roi
@@ -407,9 +410,13 @@ fn detect_prior_and_track_are_the_library_trackers() {
     assert_eq!(lines.len(), 2, "{lines:?}");
     let first = parse_line(&lines[0]).2;
     assert!(first.is_some(), "the target is found: {lines:?}");
-    assert_eq!(first, with(Some(prior)));
+    // The first file: the window around `--prior` (no look: no frame before).
+    assert_eq!(first, with(Some(prior), None));
+    // The second: the first box and its look on the first file (the same frame).
     let first_roi = first.map(|[x0, y0, x1, y1]| Roi::new(x0, y0, x1, y1));
-    assert_eq!(parse_line(&lines[1]).2, with(first_roi));
+    let look = first_roi.and_then(|r| Look::measure(&frame, r));
+    assert!(look.is_some(), "the first box has a look");
+    assert_eq!(parse_line(&lines[1]).2, with(first_roi, look));
     // `auto` the same way; a method that does not track gives its own box.
     let out = run(&[
         "detect",

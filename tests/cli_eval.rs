@@ -756,8 +756,9 @@ fn multi_page_tiff_and_bits_below_the_data() {
 
 /// `eval --track jitter` and `--track sequence` give both trackers (`auto`, `auto-v2`)
 /// their prior: each box in `scores.csv` is the library tracker's with the prior the
-/// mode defines (jitter: `jittered_prior` of the truth; sequence: the tracker's own
-/// box on the file before, by file name), and a frame without a target has none; on a
+/// mode defines (jitter: `jittered_prior` of the truth, and for `auto-v2` its look on
+/// the frame; sequence: the tracker's own box on the file before, by file name, and its
+/// look there), and a frame without a target has none; on a
 /// frame with two targets the jittered prior on the weaker one makes both box it.
 #[test]
 fn eval_track_hands_both_trackers_their_priors() {
@@ -765,6 +766,7 @@ fn eval_track_hands_both_trackers_their_priors() {
     use tirroi::core::Roi;
     use tirroi::core::roi::auto::Auto;
     use tirroi::core::roi::auto::AutoScratch;
+    use tirroi::core::roi::auto::learned::look::Look;
     use tirroi::core::roi::auto::learned::{AutoV2, AutoV2Scratch};
     use tirroi::host::eval::scoring::jittered_prior;
     use tirroi::host::imaging::image_io::read_frame;
@@ -800,7 +802,14 @@ fn eval_track_hands_both_trackers_their_priors() {
     let boxed = |r: Option<Roi>| r.map(|r| r.to_array());
     // The library's answer of `method` with `prior` on `file` (no manifest: auto-v2's
     // saturated cut is 0, as `eval` takes it).
-    let library = |method: &str, file: &str, prior: Option<Roi>| {
+    // The look `auto-v2` gets with `prior` on `file`: jitter's, the prior's on the
+    // frame itself.
+    let look_on = |file: &str, r: Option<Roi>| {
+        let buf = read_frame(&dir.path().join(file), None).unwrap();
+        let frame = buf.view().unwrap();
+        r.and_then(|r| Look::measure(&frame, r))
+    };
+    let library = |method: &str, file: &str, prior: Option<Roi>, look: Option<Look>| {
         let buf = read_frame(&dir.path().join(file), None).unwrap();
         let frame = buf.view().unwrap();
         match method {
@@ -817,6 +826,7 @@ fn eval_track_hands_both_trackers_their_priors() {
                     ..AutoV2::default()
                 }
                 .with_prior(prior)
+                .with_look(look)
                 .detect(&frame, &mut Box::new(AutoV2Scratch::new()))
                 .unwrap()
                 .roi
@@ -843,7 +853,8 @@ fn eval_track_hands_both_trackers_their_priors() {
         let (h, rows) = csv(&out.join("scores.csv"));
         let (fc, mc) = (col(&h, "file"), col(&h, "method"));
         let (x0, y1) = (col(&h, "x0"), col(&h, "y1"));
-        let mut previous: BTreeMap<String, Option<Roi>> = BTreeMap::new();
+        // Each tracker's box on the file before, and its look there.
+        let mut previous: BTreeMap<String, (Option<Roi>, Option<Look>)> = BTreeMap::new();
         let mut files: Vec<&(String, Bbox)> = truth.iter().collect();
         files.sort_by(|a, b| a.0.cmp(&b.0));
         for (file, t) in files {
@@ -853,18 +864,21 @@ fn eval_track_hands_both_trackers_their_priors() {
                     .find(|r| r[fc] == *file && r[mc] == method)
                     .unwrap_or_else(|| panic!("{file} {method} in scores.csv"));
                 let got = parse(&row[x0..=y1]);
-                let prior = match mode {
-                    "jitter" => t.map(|b| jittered_prior(Roi::new(b[0], b[1], b[2], b[3]), file)),
-                    _ => previous.get(method).copied().flatten(),
+                let (prior, look) = match mode {
+                    "jitter" => {
+                        let p = t.map(|b| jittered_prior(Roi::new(b[0], b[1], b[2], b[3]), file));
+                        (p, look_on(file, p))
+                    }
+                    _ => previous.get(method).copied().unwrap_or((None, None)),
                 };
-                let want = library(method, file, prior);
+                let want = library(method, file, prior, look);
                 assert_eq!(got, boxed(want), "{mode} {file} {method} prior {prior:?}");
                 if mode == "jitter" && file == "two-targets.png" {
                     // The prior is what makes the answer: the weaker target's box, not
                     // the stronger one's found without a prior.
-                    assert_ne!(want, library(method, file, None), "{method}");
+                    assert_ne!(want, library(method, file, None, None), "{method}");
                 }
-                previous.insert(method.to_string(), want);
+                previous.insert(method.to_string(), (want, look_on(file, want)));
             }
         }
     }

@@ -3,7 +3,9 @@
 //! is non-empty and inside the frame; its confidence is in 0..=1000 ‰, at least the
 //! threshold for a box and 0 for `null`; the threshold cuts exactly at the confidence
 //! (`null` from one ‰ above it without a tracking prior, the same box at it); the same
-//! frame gives the same answer twice, with or without a prior, in the same scratch and in a fresh one; and through the registry
+//! frame gives the same answer twice, with or without a prior (and the look of the last
+//! box, any or measured on the frame), in the same scratch and in a fresh one; a box of
+//! the fast tracking path only with a prior and a look; and through the registry
 //! (`Method::AutoV2`) it answers as called directly. Parameters out of bounds are an
 //! error, never a panic.
 //!
@@ -19,8 +21,10 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{
     AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE,
+    TRACKED_SCORE_PERMILLE,
 };
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, Roi, SCORE_FULL_PERMILLE};
@@ -54,8 +58,8 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
-        // (spot, link_cells): proptest's tuples end at 12.
-        (any::<bool>(), prop_oneof![Just(2u8), 1u8..=3]),
+        // (spot, link_cells, look): proptest's tuples end at 12.
+        (any::<bool>(), prop_oneof![Just(2u8), 1u8..=3], look()),
     )
         .prop_map(
             |(
@@ -70,10 +74,11 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
-                (spot, link_cells),
+                (spot, link_cells, look),
             )| {
                 AutoV2 {
                     prior,
+                    look,
                     fine_sigma,
                     cell_score,
                     min_score_permille,
@@ -97,6 +102,33 @@ fn prior() -> impl Strategy<Value = Option<Roi>> {
     let any = (0u16..400, 0u16..300, 0u16..400, 0u16..300)
         .prop_map(|(x0, y0, x1, y1)| Some(Roi { x0, y0, x1, y1 }));
     prop_oneof![2 => Just(None), 1 => any]
+}
+
+/// The last frame's look of the tracked target: none (weighted in), or any, also one
+/// no box could match (a departure above the bit depth) or one that tells nothing (no
+/// departure). [`with_measured_look`] adds the look a tracker would carry.
+fn look() -> impl Strategy<Value = Option<Look>> {
+    let side = prop_oneof![Just(None), any::<u16>().prop_map(Some)];
+    let any = (
+        any::<u16>(),
+        any::<u16>(),
+        [side.clone(), side.clone(), side.clone(), side],
+    )
+        .prop_map(|(level_dn, ring_dn, side_dn)| {
+            Some(Look {
+                level_dn,
+                ring_dn,
+                side_dn,
+            })
+        });
+    prop_oneof![2 => Just(None), 1 => any]
+}
+
+/// `det` with the look of its prior's box on `img` (what a tracker that found that box
+/// on this frame would carry), when it has a prior.
+fn with_measured_look(det: AutoV2, img: &Img) -> Option<AutoV2> {
+    let look = Look::measure(&img.frame(), det.prior?)?;
+    Some(det.with_look(Some(look)))
 }
 
 /// The body stage's parameters within their documented bounds (`BodyParams::is_valid`),
@@ -194,7 +226,13 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
             // The confidence is the winner's (what telemetry reads): the saturated
             // blob's when it won, else the classifier's.
             let work = scratch.work();
-            let score = if let Some((roi, score)) = work.spot() {
+            let score = if work.tracked() {
+                // The fast tracking path's box: only with a prior and a look, and no
+                // other stage ran.
+                prop_assert!(det.prior.is_some() && det.look.is_some(), "{d:?}");
+                prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
+                TRACKED_SCORE_PERMILLE
+            } else if let Some((roi, score)) = work.spot() {
                 // Stage 5e's box: the other stages answered no target.
                 prop_assert!(det.spot, "{d:?}");
                 prop_assert_eq!(Some(roi), d.roi);
@@ -284,7 +322,11 @@ proptest! {
         seed in any::<u64>(),
         det in params(),
     ) {
-        check(&shaded_sky(&mut Rng::new(seed), w, h, bits), det)?;
+        let img = shaded_sky(&mut Rng::new(seed), w, h, bits);
+        check(&img, det)?;
+        if let Some(tracked) = with_measured_look(det, &img) {
+            check(&img, tracked)?;
+        }
     }
 }
 
@@ -300,7 +342,11 @@ proptest! {
         seed in any::<u64>(),
         det in params(),
     ) {
-        check(&frame(seed, w, h, bits), det)?;
+        let img = frame(seed, w, h, bits);
+        check(&img, det)?;
+        if let Some(tracked) = with_measured_look(det, &img) {
+            check(&img, tracked)?;
+        }
     }
 }
 
@@ -316,7 +362,11 @@ proptest! {
         seed in any::<u64>(),
         det in params(),
     ) {
-        check(&frame(seed, w, h, bits), det)?;
+        let img = frame(seed, w, h, bits);
+        check(&img, det)?;
+        if let Some(tracked) = with_measured_look(det, &img) {
+            check(&img, tracked)?;
+        }
     }
 
     /// Parameters out of bounds: an error naming the field, never a panic, on any frame.

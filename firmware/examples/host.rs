@@ -18,6 +18,7 @@
 use std::process::ExitCode;
 
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::{Frame, Method};
 use tirroi_firmware::frames::FRAMES;
 use tirroi_firmware::synth::Tables;
@@ -102,7 +103,7 @@ fn one(ws: &mut Workspace<'_>, frame: &str, method: &str) -> Result<String, Stri
             .roi
             .ok_or_else(|| format!("{method} found nothing to track"))?;
         detection = detectors
-            .track(method, prior, &view)
+            .track(method, prior, Look::measure(&view, prior), &view)
             .map_err(|e| e.to_string())?;
     }
     Ok(format!("{frame} {method} {:?}", detection.roi))

@@ -4,6 +4,7 @@
 //! six (190 KB, the core's registry bank [`tirroi_core::roi::Detectors`]).
 
 use tirroi_core::roi::adaptive::{Adaptive, AdaptiveScratch};
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::dog::{Dog, DogScratch};
@@ -153,7 +154,9 @@ impl Detectors {
 
     /// Runs a tracker, `auto` or `auto-v2` (default parameters), in tracking mode: a
     /// window around `prior` (the last frame's box) first, the whole frame only when
-    /// the target is lost there.
+    /// the target is lost there. `look` (the last box's [`Look`] on the last frame;
+    /// `auto-v2` only, `auto` ignores it) lets `auto-v2` take the fast path first
+    /// ([`AutoV2::look`]).
     ///
     /// Never inlined, for the same reason as [`Detectors::run`].
     ///
@@ -164,6 +167,7 @@ impl Detectors {
         &mut self,
         method: Method,
         prior: Roi,
+        look: Option<Look>,
         frame: &Frame<'_>,
     ) -> Result<Detection, DetectError> {
         match method {
@@ -173,7 +177,7 @@ impl Detectors {
             }
             Method::AutoV2 => auto_v2_in(
                 &mut self.shared,
-                AutoV2::default().with_prior(Some(prior)),
+                AutoV2::default().with_prior(Some(prior)).with_look(look),
                 frame,
             ),
             _ => Err(NOT_A_TRACKER),

@@ -29,6 +29,7 @@ use core::hint::black_box;
 
 use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
 use tirroi_core::link::{FrameReader, SimulatedCamera};
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::{Frame, Method};
 
 pub use detectors::{DEMO_METHODS, Detectors};
@@ -198,11 +199,14 @@ fn detect_all<M: Meter>(
             *prior = found;
         }
     }
-    // Tracking: each tracker again, given its own box as the last frame's.
+    // Tracking: each tracker again, given its own box as the last frame's (and, for
+    // `auto-v2`, that box's look, taken as a tracker takes it after each frame:
+    // counted with the call).
     for (method, prior) in priors {
         let Some(prior) = prior else { continue };
         meter.start();
-        let result = black_box(detectors.track(method, prior, &frame));
+        let look = Look::measure(&frame, prior);
+        let result = black_box(detectors.track(method, prior, look, &frame));
         let reading = meter.stop();
         report_detection(emit, name, method, Some(prior), truth, result, reading);
     }

@@ -28,7 +28,7 @@ mod target {
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
     use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
     use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
-    use tirroi_firmware::adversarial::{self, AUTO_V2_PRIORS, PRIORS};
+    use tirroi_firmware::adversarial::{self, AUTO_V2_PRIORS, PRIORS, REFUSED_LOOK};
     use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
 
@@ -137,7 +137,12 @@ mod target {
                     continue;
                 }
                 for &prior in priors {
-                    let (result, n) = count(overhead, || DETECTORS.track(method, prior, &frame));
+                    // `auto-v2` with a look no box can match: its fast path runs
+                    // to the end and is refused, then the window and the frame are
+                    // searched (the most a call with a prior can cost).
+                    let look = (method == Method::AutoV2).then_some(REFUSED_LOOK);
+                    let (result, n) =
+                        count(overhead, || DETECTORS.track(method, prior, look, &frame));
                     failed |= result.is_err();
                     calls += 1;
                     hprintln!(

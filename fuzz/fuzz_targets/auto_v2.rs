@@ -9,7 +9,8 @@
 //! u16, mod 1001), byte 8 `saturated_erode_px` (mod 9) and, by its top bit, the body
 //! stage on (`BodyParams::DEFAULT`) or off; when byte 2's top bit is set, bytes 9..17
 //! a tracking prior (x0, y0, x1, y1, little-endian u16: any box, cut to the frame by
-//! the detector); the rest the DN (little-endian u16, repeated to fill the frame;
+//! the detector) and, when byte 3's bit 1 is set, the prior's look on the frame
+//! (`auto-v2`'s fast tracking path); the rest the DN (little-endian u16, repeated to fill the frame;
 //! none: a black frame). When byte 2's bit 6 is set (and there are more than 48 DN), a
 //! smooth frame instead, the ground of stage 2c (deep space): the first 48 DN are an
 //! 8 × 6 grid of levels interpolated bilinearly over the frame (kinks and steps between
@@ -20,6 +21,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use tirroi_core::roi::auto::learned::body::BodyParams;
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
 use tirroi_core::{Detector, Frame, Roi, SCORE_FULL_PERMILLE};
 
@@ -68,6 +70,7 @@ fuzz_target!(|data: &[u8]| {
     };
     let det = AutoV2 {
         prior,
+        look: None,
         fine_sigma: 1 + u16::from(data[3] % 40),
         cell_score: (i32::from(i16::from_le_bytes([data[4], data[5]])).rem_euclid(8193) - 4096)
             as i16,
@@ -103,6 +106,13 @@ fuzz_target!(|data: &[u8]| {
             .collect()
     };
     let frame = Frame::new(&pixels, w, h, bits).expect("valid dimensions");
+    // The look a tracker carries: the prior's on this frame (its fast path), by byte
+    // 3's bit 1.
+    let det = if data[3] & 0x02 != 0 {
+        det.with_look(prior.and_then(|p| Look::measure(&frame, p)))
+    } else {
+        det
+    };
     let mut scratch = Box::new(AutoV2Scratch::new());
     let d = det.detect(&frame, &mut scratch).expect("valid parameters");
     assert!(d.score_permille <= SCORE_FULL_PERMILLE, "{d:?}");

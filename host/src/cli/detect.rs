@@ -12,6 +12,7 @@ use crate::eval::bank::DetectorBank;
 use crate::imaging::image_io::{ReadOptions, parse_box_px, parse_crop, read_frame_with};
 use tirroi_core::Method;
 use tirroi_core::roi::auto::learned::AutoV2;
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
 
 /// The options of `tirroi detect`.
@@ -66,7 +67,9 @@ pub struct DetectArgs {
     pub prior: Option<tirroi_core::Roi>,
     /// The files are a sequence, in the order given: each tracker's prior on a file is
     /// its own box on the file before (none after a miss; on the first file,
-    /// `--prior`).
+    /// `--prior`), and `auto-v2` carries that box's look (its level against the
+    /// background on each side) to take its fast path: the last box's cells refined
+    /// without the classifier, kept when the new box looks the same.
     #[arg(long)]
     pub track: bool,
     /// Frames to process (PNG, TIFF or FITS).
@@ -138,6 +141,9 @@ pub fn run(args: &DetectArgs) -> ExitCode {
     let mut out = stdout.lock();
     // Each method's prior for the next file (used by the trackers only).
     let mut priors = vec![args.prior; methods.len()];
+    // `auto-v2`'s look of its last box on the file before (`--track`; none for
+    // `--prior`, which has no frame: there the window is searched).
+    let mut looks: Vec<Option<Look>> = vec![None; methods.len()];
     for path in files {
         let options = ReadOptions {
             bits,
@@ -165,8 +171,12 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                 continue;
             }
         };
-        for (&method, prior) in methods.iter().zip(priors.iter_mut()) {
+        for ((&method, prior), look) in methods.iter().zip(priors.iter_mut()).zip(looks.iter_mut())
+        {
             bank.set_prior_of(method, *prior);
+            if method == Method::AutoV2 {
+                bank.set_look(*look);
+            }
             let budget = args
                 .budget
                 .filter(|_| method == Method::Auto)
@@ -188,6 +198,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
             };
             if args.track {
                 *prior = d.roi;
+                *look = d.roi.and_then(|r| Look::measure(&view, r));
             }
             let file = path.to_string_lossy();
             let written = if json {

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
 use tirroi_core::roi::auto::learned::AutoV2;
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method, Roi};
@@ -104,6 +105,15 @@ impl DetectorBank {
                 }
             }
             _ => {}
+        }
+    }
+
+    /// Sets the look of the tracked target on the last frame
+    /// ([`tirroi_core::roi::auto::learned::look::Look`]), which only `auto-v2` carries
+    /// ([`AutoV2::look`]: its fast tracking path).
+    pub fn set_look(&mut self, look: Option<Look>) {
+        if let Some(Params::AutoV2(v2)) = self.others.get_mut(Method::AutoV2.index()) {
+            v2.look = look;
         }
     }
 

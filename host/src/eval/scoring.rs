@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use serde::Serialize;
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::{BoxRule, Method, Roi};
 
 use crate::eval::bank::{DetectorBank, median};
@@ -590,8 +591,12 @@ pub fn score(
                     .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
                 let mut out = Vec::with_capacity(options.methods.len());
                 if options.track == Track::Jitter {
-                    // No target, nothing for a tracker to hand over.
-                    bank.set_prior(row.has_target().then(|| jittered_prior(row.roi, &row.file)));
+                    // No target, nothing for a tracker to hand over. The look a tracker
+                    // took of its last box: the prior's, on this frame (the jitter
+                    // stands for the last frame's box).
+                    let prior = row.has_target().then(|| jittered_prior(row.roi, &row.file));
+                    bank.set_prior(prior);
+                    bank.set_look(prior.and_then(|p| Look::measure(&view, p)));
                 }
                 for &m in &options.methods {
                     out.push(score_one(bank, m, &view, row, &path, options.repeat)?.0);
@@ -679,7 +684,7 @@ fn score_sequence(
     let mut order: Vec<&TruthRow> = rows.iter().collect();
     order.sort_by(|a, b| a.file.cmp(&b.file));
     // Each tracker's box on the previous frame, by method.
-    let mut previous: Vec<Option<Roi>> = vec![None; options.methods.len()];
+    let mut previous: Vec<Option<(Roi, Option<Look>)>> = vec![None; options.methods.len()];
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     for row in order {
         let path: PathBuf = images.join(&row.file);
@@ -688,9 +693,13 @@ fn score_sequence(
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
         for (&m, prev) in options.methods.iter().zip(previous.iter_mut()) {
-            bank.set_prior_of(m, *prev);
+            bank.set_prior_of(m, prev.map(|(r, _)| r));
+            if m == Method::AutoV2 {
+                bank.set_look(prev.and_then(|(_, look)| look));
+            }
             let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
-            *prev = roi;
+            // The tracker's box and its look on this frame, for the next.
+            *prev = roi.map(|r| (r, Look::measure(&view, r)));
             scores.push(score);
         }
         progress();

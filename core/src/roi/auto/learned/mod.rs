@@ -31,6 +31,7 @@ pub mod features;
 pub mod forest;
 mod forest_trees;
 pub mod half_max;
+pub mod look;
 pub mod narrow;
 pub mod order;
 pub mod prescreen;
@@ -64,6 +65,14 @@ pub struct AutoV2 {
     /// a border of the window inside the frame, else the whole frame is searched. Any box is accepted; it is cut to the frame, and an
     /// empty result means no prior.
     pub prior: Option<Roi>,
+    /// The look of the prior's target on the last frame ([`look::Look::measure`] of
+    /// the last box), or `None`. With a prior and a look, a fast path runs first: the
+    /// prior's cells taken for the target's and refined by stages 5–8 in a window
+    /// around it (the classifier does not run); its box stands when it stays in the
+    /// window, overlaps the prior by [`TRACK_FAST_MIN_IOU_PERMILLE`] and looks like the
+    /// last frame's target ([`look::Look::matches`]), with confidence
+    /// [`TRACKED_SCORE_PERMILLE`]; otherwise the call goes on as with the prior alone.
+    pub look: Option<look::Look>,
     /// Full-resolution boundary threshold, multiples of σ: 1..=1000. Default 8 (as `auto`).
     pub fine_sigma: u16,
     /// A cell is a target cell when its score reaches this, score units
@@ -189,6 +198,58 @@ pub const TRACK_MARGIN_PX: usize = 16;
 /// `auto-v2+prior`, docs/flight.md).
 pub const TRACK_MAX_WINDOW_PERMILLE: usize = 500;
 
+/// The fast tracking path's window ([`AutoV2::look`]): the prior grown by this many
+/// pixels plus its longer side / [`TRACK_FAST_MARGIN_DIVISOR`] on every side (`auto`'s
+/// tracking window): room for a move of several pixels per frame and for the body
+/// stage's ring; the classifier does not run there, so the window's own levels do not
+/// shrink the box as they do in [`TRACK_MARGIN_PX`]'s window.
+pub const TRACK_FAST_MARGIN_PX: usize = 16;
+
+/// See [`TRACK_FAST_MARGIN_PX`].
+pub const TRACK_FAST_MARGIN_DIVISOR: usize = 8;
+
+/// The fast path's box must overlap the prior by at least this IoU, ‰: a box that
+/// drifted further from the last one is left to the search. Chosen on family A (seed
+/// 7001, `--track jitter`): 300 / 500 / 600 / 700 → summed mean IoU change +0.065 /
+/// +0.054 / +0.048 / +0.031 against tracking without the fast path.
+pub const TRACK_FAST_MIN_IOU_PERMILLE: u64 = 300;
+
+/// Each side of the fast path's box may lie at most this many pixels plus
+/// [`TRACK_FAST_SIDE_SLACK_PERMILLE`] of the prior's width (height) from the prior's
+/// side: a target moves a few pixels and grows by a few per cent between frames, a box
+/// that grew more took in background (the tracker would drift). The jittered priors of
+/// `--track jitter` lie within 4 px + 10 %.
+pub const TRACK_FAST_SIDE_SLACK_PX: u32 = 4;
+
+/// See [`TRACK_FAST_SIDE_SLACK_PX`], ‰.
+pub const TRACK_FAST_SIDE_SLACK_PERMILLE: u32 = 100;
+
+/// Whether the fast path's box `r` follows the prior `p` (both cut to the frame): an
+/// IoU of [`TRACK_FAST_MIN_IOU_PERMILLE`] or more and every side within
+/// [`TRACK_FAST_SIDE_SLACK_PX`] + [`TRACK_FAST_SIDE_SLACK_PERMILLE`] of the prior's.
+fn follows_prior(p: &Roi, r: &Roi) -> bool {
+    let inter = u64::from(p.intersection(r).area());
+    let union = u64::from(p.area()) + u64::from(r.area()) - inter;
+    let slack = |size: u16| {
+        TRACK_FAST_SIDE_SLACK_PX + u32::from(size) * TRACK_FAST_SIDE_SLACK_PERMILLE / 1000
+    };
+    let (sx, sy) = (slack(p.width()), slack(p.height()));
+    let near = |a: u16, b: u16, s: u32| u32::from(a.abs_diff(b)) <= s;
+    inter * 1000 >= union * TRACK_FAST_MIN_IOU_PERMILLE
+        && near(r.x0, p.x0, sx)
+        && near(r.x1, p.x1, sx)
+        && near(r.y0, p.y0, sy)
+        && near(r.y1, p.y1, sy)
+}
+
+/// Confidence of a box of the fast tracking path, ‰: its hit rate (IoU ≥ ½) on family
+/// A (seed 7001: famA, paper A, fixtures A, famAF, famAT) with `tirroi eval --track
+/// jitter`, 502 of 504 (the two misses far targets of famAF); held out 437 of 437
+/// (`docs/detectors.md` § Session 41). A P(hit) given a prior on the target: a wrong
+/// prior whose box passes the look's checks is not in it (none on family A's
+/// `--track sequence`).
+pub const TRACKED_SCORE_PERMILLE: u16 = 996;
+
 /// The answer "no target": no box, confidence 0.
 const NO_TARGET: Detection = Detection {
     roi: None,
@@ -218,6 +279,7 @@ impl Default for AutoV2 {
     fn default() -> Self {
         AutoV2 {
             prior: None,
+            look: None,
             fine_sigma: 8,
             cell_score: 0,
             min_score_permille: 550,
@@ -380,6 +442,7 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     winner: Option<Winner>,
     blob: Option<blob::BlobStats>,
     blob_won: bool,
+    tracked: bool,
     deep_space: Option<smooth::DeepSpace>,
     spot: Option<(Roi, u16)>,
 }
@@ -428,6 +491,14 @@ impl<C: FrameCapacity> AutoV2Work<C> {
         self.deep_space
     }
 
+    /// Whether the last frame's box came from the fast tracking path
+    /// ([`AutoV2::look`]; it carries [`TRACKED_SCORE_PERMILLE`], and no other stage
+    /// ran: [`Self::winner`], [`Self::blob`], [`Self::deep_space`] and [`Self::spot`]
+    /// are then `None`).
+    pub fn tracked(&self) -> bool {
+        self.tracked
+    }
+
     /// Stage 5e's answer on the last frame (its most confident spot's box and
     /// confidence ‰, whether or not it reached the gate) when the stage ran; `None`
     /// when another stage answered or the stage is off.
@@ -457,6 +528,7 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         winner: None,
         blob: None,
         blob_won: false,
+        tracked: false,
         deep_space: None,
         spot: None,
     };
@@ -850,6 +922,7 @@ fn prepare<C: FrameCapacity>(
 }
 
 /// Stages 1–2 without the integrals ([`integrate_cells`]): noise, cell planes, levels.
+#[inline(always)]
 fn prepare_cells<C: FrameCapacity>(
     frame: &Frame<'_>,
     work: &mut AutoV2Work<C>,
@@ -946,6 +1019,11 @@ impl AutoV2 {
         AutoV2 { prior, ..self }
     }
 
+    /// Sets the look of the prior's target on the last frame ([`AutoV2::look`]).
+    pub const fn with_look(self, look: Option<look::Look>) -> Self {
+        AutoV2 { look, ..self }
+    }
+
     /// The tracking window around the prior, `None` without a prior, for an empty one
     /// (cut to the frame) or when the window is over [`TRACK_MAX_WINDOW_PERMILLE`] of
     /// the frame.
@@ -961,6 +1039,9 @@ impl AutoV2 {
     /// stands when it passes the gate, overlaps the prior and is not cut by the
     /// window's border inside the frame), else on the whole frame.
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
+        if let Some(d) = self.track_fast(frame, work) {
+            return d;
+        }
         if let Some((prior, win)) = self.tracking_window(frame) {
             let d = self.run_in(frame, work, win);
             if d.roi.is_some_and(|r| win.keeps(frame, &prior, &r)) {
@@ -968,6 +1049,73 @@ impl AutoV2 {
             }
         }
         self.run_in(frame, work, Window::full(frame))
+    }
+
+    /// The fast tracking path ([`AutoV2::look`]): the prior's cells refined by stages
+    /// 5–8 in a window around the prior; `Some` when the box stays in the window,
+    /// follows the prior ([`follows_prior`]) and looks like the last frame's target,
+    /// else `None` (the search decides). Costs the window's noise and cell planes, the
+    /// refinement and two looks (the box and its strips).
+    #[inline(never)]
+    fn track_fast<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+    ) -> Option<Detection> {
+        let last = self.look?;
+        if TRACKED_SCORE_PERMILLE < self.min_score_permille {
+            return None;
+        }
+        let (p, win) = Window::around(frame, self.prior?, |p| {
+            TRACK_FAST_MARGIN_PX
+                + usize::from(p.width().max(p.height())) / TRACK_FAST_MARGIN_DIVISOR
+        })?;
+        // A window over half the frame saves less than half a search (and a refused
+        // box pays both): the search decides, as for the window of the prior alone.
+        if win.w * win.h * 1000 > frame.width() * frame.height() * TRACK_MAX_WINDOW_PERMILLE {
+            return None;
+        }
+        let (plane8, lv) = prepare_cells(frame, work, win);
+        if !last.is_distinct(lv.sigma) {
+            return None;
+        }
+        // The cells the prior overlaps as the only target cells (code 255; `labels4`
+        // held the saturated counts, which the fast path does not read).
+        let n8 = plane8.0 * plane8.1;
+        let codes = work.labels4.as_mut().get_mut(..n8)?;
+        let (x0, y0) = (usize::from(p.x0), usize::from(p.y0));
+        let (x1, y1) = (usize::from(p.x1), usize::from(p.y1));
+        for (i, code) in codes.iter_mut().enumerate() {
+            let (cx, cy) = (i % plane8.0.max(1), i / plane8.0.max(1));
+            let (ca, cb) = (win.x0 + cx * cells::CELL_PX, win.y0 + cy * cells::CELL_PX);
+            let overlaps =
+                ca < x1 && ca + cells::CELL_PX > x0 && cb < y1 && cb + cells::CELL_PX > y0;
+            *code = if overlaps { u8::MAX } else { 0 };
+        }
+        let winner = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
+        let d = self.finish(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            winner,
+            TRACKED_SCORE_PERMILLE,
+            false,
+        );
+        let r = d.roi?;
+        let now = look::Look::measure(frame, r)?;
+        if !(win.keeps(frame, &p, &r) && follows_prior(&p, &r) && last.matches(&now, lv.sigma)) {
+            return None;
+        }
+        // What the other stages would have left: nothing (telemetry reads the flag).
+        work.tracked = true;
+        work.winner = None;
+        work.blob = None;
+        work.blob_won = false;
+        work.deep_space = None;
+        work.spot = None;
+        Some(d)
     }
 
     /// Every stage on the frame's window `win` (the whole frame, or the tracking
@@ -981,6 +1129,7 @@ impl AutoV2 {
         // Stages 1–2: noise, cell planes, levels (the integrals after stage 2c, which
         // uses their plane as scratch).
         let (plane8, lv) = prepare_cells(frame, work, win);
+        work.tracked = false;
         work.spot = None;
         let d = self.region_stages(frame, work, win, plane8, lv);
         if d.roi.is_some() || !self.spot {
@@ -2019,6 +2168,71 @@ mod tests {
                 "{p:?}"
             );
         }
+    }
+
+    /// The fast tracking path: with the look of the weak block's box carried from the
+    /// last frame, the prior's cells refined alone give the block's box with
+    /// [`TRACKED_SCORE_PERMILLE`] (and no other stage's trace); the same prior and look
+    /// over a frame without that block (the target left: the prior on background),
+    /// over the strong block (another target: its level 1 500 DN above the last box's,
+    /// more than half the last departure), or
+    /// with a look that stood out by less than [`look::MIN_DEPARTURE_SIGMA`] give the
+    /// answer without a look.
+    #[test]
+    fn the_fast_path_keeps_a_target_that_looks_the_same_and_nothing_else() {
+        let strong = (60usize, 60usize, 120usize, 110usize, 3000u16);
+        let weak = (230usize, 150usize, 270usize, 190usize, 1500u16);
+        let px = blocks_frame(&[strong, weak]);
+        let frame = Frame::reference(&px).unwrap();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let truth = Roi::new(230, 150, 270, 190);
+        let last = look::Look::measure(&frame, truth).expect("a look");
+        let prior = Roi::new(233, 152, 266, 185);
+        let det = AutoV2::default().with_prior(Some(prior));
+        let fast = det
+            .with_look(Some(last))
+            .detect(&frame, &mut scratch)
+            .unwrap();
+        assert!(scratch.work().tracked(), "{fast:?}");
+        assert_eq!(fast.score_permille, TRACKED_SCORE_PERMILLE);
+        assert!(scratch.work().winner().is_none());
+        let r = fast.roi.expect("the tracked block");
+        assert!(r.iou(&truth) > 0.9, "{r:?}");
+        // The next call without a look: the flag goes.
+        det.detect(&frame, &mut scratch).unwrap();
+        assert!(!scratch.work().tracked());
+        // The block gone: the prior lies on the background.
+        let gone_px = blocks_frame(&[strong]);
+        let gone = Frame::reference(&gone_px).unwrap();
+        let want = det.detect(&gone, &mut scratch).unwrap();
+        let got = det
+            .with_look(Some(last))
+            .detect(&gone, &mut scratch)
+            .unwrap();
+        assert!(!scratch.work().tracked());
+        assert_eq!(got, want);
+        // The prior on the strong block (3 000 DN above the background against the weak
+        // one's 1 500).
+        let on_strong = AutoV2::default().with_prior(Some(Roi::new(62, 62, 118, 108)));
+        let want = on_strong.detect(&frame, &mut scratch).unwrap();
+        let got = on_strong
+            .with_look(Some(last))
+            .detect(&frame, &mut scratch)
+            .unwrap();
+        assert!(!scratch.work().tracked());
+        assert_eq!(got, want);
+        // A look that did not stand out: the search decides.
+        let faint = look::Look {
+            level_dn: last.ring_dn + 1,
+            ..last
+        };
+        let want = det.detect(&frame, &mut scratch).unwrap();
+        let got = det
+            .with_look(Some(faint))
+            .detect(&frame, &mut scratch)
+            .unwrap();
+        assert!(!scratch.work().tracked());
+        assert_eq!(got, want);
     }
 
     /// A frame of deep space as a real camera shows it: a 2 000 DN pedestal, a shading

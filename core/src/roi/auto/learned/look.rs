@@ -1,0 +1,264 @@
+//! What a tracker carries of its last box besides the box: the target's look, its
+//! mean DN and the mean DN of the background just around it, side by side.
+//! `auto-v2`'s fast tracking path ([`super::AutoV2::look`]) takes the prior's cells for
+//! the target's and keeps the box it refines from them only when that box looks like
+//! the last frame's target: it departs from its ring the same way by ½–2 times as
+//! much, its level moved by at most half the last departure, and it stands out from
+//! the background on every side. A box a wrong prior put on background departs by
+//! another amount or not at all, and one on the limb or a cloud deck's edge has a side
+//! that does not depart (`tirroi eval --track sequence` on family A's fixtures: such
+//! boxes on 3 of 80 frames without a target before the side rule, none after); the
+//! search then runs instead.
+//!
+//! A look is a sum over the box and four strips of [`RING_PX`] along its sides: each
+//! pixel of the box and its strips read once, no scratch.
+
+use crate::frame::Frame;
+use crate::roi::Roi;
+
+/// Width of the background ring around a box, px: wide enough for a mean over a few
+/// dozen pixels around a 3-px far target, narrow enough to stay on the background the
+/// target crosses (a wider ring reaches other clouds).
+pub const RING_PX: u16 = 2;
+
+/// The last look serves only when its box departed from its ring by at least this
+/// many pixel noise σ (of the new frame's tracking window): a box that does not stand
+/// out tells nothing a wrong prior could not also show, and the search decides.
+/// Chosen on family A (seed 7001; summed mean IoU change of `--track jitter` and
+/// `--track sequence` against tracking without the fast path): 1 and 2 → +0.072 /
+/// −0.007, 4 → +0.057 / −0.007, 8 → +0.030 / −0.004; 2, the stricter of the two best.
+pub const MIN_DEPARTURE_SIGMA: u32 = 2;
+
+/// The new box's departure from its ring must lie within this factor of the last
+/// one's (either way, same sign): the target's contrast against the background it
+/// moves over changes between frames, but not by more than twice. Family A (as
+/// [`MIN_DEPARTURE_SIGMA`], at 4 σ): 2 → +0.057 / −0.007, 3 → +0.060 / −0.014.
+pub const DEPARTURE_FACTOR: i64 = 2;
+
+/// The new box's mean DN may differ from the last one's by at most this share of the
+/// last departure, ‰: the target's own level changes less than its background.
+/// Family A (as [`DEPARTURE_FACTOR`]): 150 → +0.016 (jitter), 300 → +0.054 / −0.012,
+/// 500 → +0.057 / −0.007, 1000 → +0.055 / −0.011.
+pub const LEVEL_SHARE_PERMILLE: i64 = 500;
+
+/// Mean DN (clamped to the frame's top DN) of the pixels of `r`, a box inside the
+/// frame, and their count; `None` when it is empty.
+fn mean_dn(frame: &Frame<'_>, r: Roi) -> Option<(u16, u64)> {
+    if r.is_empty() {
+        return None;
+    }
+    let max_dn = frame.max_dn();
+    let mut sum = 0u64;
+    for y in r.y0..r.y1 {
+        let row = frame.row(usize::from(y))?;
+        let row = row.get(usize::from(r.x0)..usize::from(r.x1))?;
+        sum += row.iter().map(|&v| u64::from(v.min(max_dn))).sum::<u64>();
+    }
+    let n = u64::from(r.area());
+    Some(((sum / n) as u16, n))
+}
+
+/// The look of a box: mean DN inside it and in the strips of [`RING_PX`] along each of
+/// its sides (DN, the frame's pixels clamped to its top DN; a strip outside the frame
+/// is absent; the corners belong to no strip).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Look {
+    /// Mean DN of the box's pixels.
+    pub level_dn: u16,
+    /// Mean DN of all the strips' pixels (the ring).
+    pub ring_dn: u16,
+    /// Mean DN of the strip above, below, left of and right of the box, `None` where
+    /// the box lies on the frame's border.
+    pub side_dn: [Option<u16>; 4],
+}
+
+impl Look {
+    /// The look of `roi` on `frame`; `None` when the box, cut to the frame, is empty
+    /// or no strip lies inside the frame (a box of the whole frame).
+    pub fn measure(frame: &Frame<'_>, roi: Roi) -> Option<Look> {
+        let (fw, fh) = (frame.width() as u16, frame.height() as u16);
+        let inner = roi.clip(fw, fh);
+        if inner.is_empty() {
+            return None;
+        }
+        let (level, _) = mean_dn(frame, inner)?;
+        let strips = [
+            Roi::new(
+                inner.x0,
+                inner.y0.saturating_sub(RING_PX),
+                inner.x1,
+                inner.y0,
+            ),
+            Roi::new(
+                inner.x0,
+                inner.y1,
+                inner.x1,
+                inner.y1.saturating_add(RING_PX),
+            ),
+            Roi::new(
+                inner.x0.saturating_sub(RING_PX),
+                inner.y0,
+                inner.x0,
+                inner.y1,
+            ),
+            Roi::new(
+                inner.x1,
+                inner.y0,
+                inner.x1.saturating_add(RING_PX),
+                inner.y1,
+            ),
+        ];
+        let mut side_dn = [None; 4];
+        let (mut sum, mut px) = (0u64, 0u64);
+        for (side, strip) in side_dn.iter_mut().zip(strips) {
+            if let Some((mean, n)) = mean_dn(frame, strip.clip(fw, fh)) {
+                *side = Some(mean);
+                sum += u64::from(mean) * n;
+                px += n;
+            }
+        }
+        if px == 0 {
+            return None;
+        }
+        Some(Look {
+            level_dn: level,
+            ring_dn: (sum / px) as u16,
+            side_dn,
+        })
+    }
+
+    /// Mean DN of the box minus that of its ring (DN; negative for a target colder
+    /// than its background).
+    pub const fn departure_dn(&self) -> i32 {
+        self.level_dn as i32 - self.ring_dn as i32
+    }
+
+    /// Whether this look (the last frame's) tells a target at all under pixel noise
+    /// `sigma` (DN): the box departs by [`MIN_DEPARTURE_SIGMA`] σ or more.
+    pub fn is_distinct(&self, sigma: u32) -> bool {
+        i64::from(self.departure_dn()).unsigned_abs()
+            >= u64::from(MIN_DEPARTURE_SIGMA) * u64::from(sigma.max(1))
+    }
+
+    /// Whether `now` (a box found this frame) is the target this look (the last
+    /// frame's) was taken of, under pixel noise `sigma` (DN): the last look is distinct,
+    /// the new box departs from its ring in the same direction by ½–2 times as much,
+    /// and its level moved by at most [`LEVEL_SHARE_PERMILLE`] of the last departure.
+    pub fn matches(&self, now: &Look, sigma: u32) -> bool {
+        if !self.is_distinct(sigma) {
+            return false;
+        }
+        let (last, new) = (
+            i64::from(self.departure_dn()),
+            i64::from(now.departure_dn()),
+        );
+        let same_sign = (last > 0) == (new > 0) && new != 0;
+        let (a_last, a_new) = (last.abs(), new.abs());
+        let level_moved = (i64::from(now.level_dn) - i64::from(self.level_dn)).abs();
+        // Every side of the new box departs the same way: a box on an edge (the limb, a
+        // cloud deck) has a side that does not.
+        let sides_depart = now.side_dn.iter().flatten().all(|&side| {
+            let d = i64::from(now.level_dn) - i64::from(side);
+            d != 0 && (d > 0) == (last > 0)
+        });
+        same_sign
+            && sides_depart
+            && a_new * DEPARTURE_FACTOR >= a_last
+            && a_new <= a_last * DEPARTURE_FACTOR
+            && level_moved * 1000 <= a_last * LEVEL_SHARE_PERMILLE
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 32×24 frame at `bg` with a `value` block at (10..16, 8..12).
+    fn frame_with_block(bg: u16, value: u16, px: &mut [u16]) -> Frame<'_> {
+        for (i, p) in px.iter_mut().enumerate() {
+            let (x, y) = (i % 32, i / 32);
+            *p = if (10..16).contains(&x) && (8..12).contains(&y) {
+                value
+            } else {
+                bg
+            };
+        }
+        Frame::new(px, 32, 24, 14).expect("a valid frame")
+    }
+
+    /// A look with every side at the ring's level.
+    fn look(level_dn: u16, ring_dn: u16) -> Look {
+        Look {
+            level_dn,
+            ring_dn,
+            side_dn: [Some(ring_dn); 4],
+        }
+    }
+
+    /// The look of a block's own box is its level and the background's, by hand.
+    #[test]
+    fn measures_the_box_and_its_strips() {
+        let mut px = [0u16; 32 * 24];
+        let f = frame_with_block(1000, 1400, &mut px);
+        let own = Look::measure(&f, Roi::new(10, 8, 16, 12)).expect("a look");
+        assert_eq!(own, look(1400, 1000));
+        assert_eq!(own.departure_dn(), 400);
+        // One column of background inside the box: (6·4·1400 + 4·1000) / 28; its
+        // top and bottom strips hold one background and six block pixels, 2 rows.
+        let wider = Look::measure(&f, Roi::new(9, 8, 16, 12)).expect("a look");
+        assert_eq!(wider.level_dn, ((24 * 1400 + 4 * 1000) / 28) as u16);
+        assert_eq!(wider.side_dn[0], Some(1000));
+        assert_eq!(wider.side_dn[2], Some(1000));
+        // A box reaching into the block from above: its bottom strip is the block's.
+        let above = Look::measure(&f, Roi::new(10, 4, 16, 8)).expect("a look");
+        assert_eq!(above.side_dn[1], Some(1400));
+        // In the corner the strips above and left lie outside the frame.
+        let corner = Look::measure(&f, Roi::new(0, 0, 3, 3)).expect("a look");
+        assert_eq!(corner.side_dn[0], None);
+        assert_eq!(corner.side_dn[2], None);
+        assert_eq!(corner.side_dn[1], Some(1000));
+        // No strip (the whole frame) and nothing inside: no look.
+        assert_eq!(Look::measure(&f, Roi::new(0, 0, 32, 24)), None);
+        assert_eq!(Look::measure(&f, Roi::new(40, 40, 50, 50)), None);
+    }
+
+    /// The same target matches itself; background, the other sign, a halved or
+    /// doubled-and-more departure, a moved level or a side that does not depart do not;
+    /// an indistinct look matches nothing.
+    #[test]
+    fn matches_only_the_same_target() {
+        let last = look(1400, 1000);
+        let sigma = 10;
+        assert!(last.matches(&last, sigma));
+        // The background moved under the target: the departure 400 → 250 and 700
+        // match (within twice), 900 does not.
+        assert!(last.matches(&look(1400, 1150), sigma));
+        assert!(last.matches(&look(1400, 700), sigma));
+        assert!(!last.matches(&look(1400, 500), sigma));
+        // A patch of background: no departure; a cold target: the other sign.
+        assert!(!last.matches(&look(1005, 1000), sigma));
+        assert!(!last.matches(&look(600, 1000), sigma));
+        // Half the departure (the boundary) matches; less does not.
+        assert!(last.matches(&look(1400, 1200), sigma));
+        assert!(!last.matches(&look(1400, 1201), sigma));
+        // Level moved by half the last departure (200 DN) matches; by more does not.
+        assert!(last.matches(&look(1600, 1200), sigma));
+        assert!(!last.matches(&look(1601, 1201), sigma));
+        // A box on an edge: the ring departs on average, one side does not.
+        let edge = Look {
+            side_dn: [Some(700), Some(1400), Some(1000), Some(1000)],
+            ..look(1400, 1025)
+        };
+        assert!(!last.matches(&edge, sigma));
+        // A side off the frame is no objection.
+        let cut = Look {
+            side_dn: [None, Some(1000), Some(1000), None],
+            ..look(1400, 1000)
+        };
+        assert!(last.matches(&cut, sigma));
+        // A look within 2 σ of its ring tells nothing.
+        let faint = look(1019, 1000);
+        assert!(!faint.matches(&faint, sigma));
+        assert!(faint.matches(&faint, 9));
+    }
+}
