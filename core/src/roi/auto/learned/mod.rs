@@ -2116,14 +2116,19 @@ mod tests {
             .collect()
     }
 
+    /// The two blocks of the tracking tests (x0, y0, x1, y1, DN above the background):
+    /// a strong one and a weak one, both found on their own.
+    const STRONG_BLOCK: (usize, usize, usize, usize, u16) = (60, 60, 120, 110, 3000);
+    /// See [`STRONG_BLOCK`].
+    const WEAK_BLOCK: (usize, usize, usize, usize, u16) = (230, 150, 270, 190, 1500);
+
     /// Tracking: with a prior on the weaker of two targets, the box is that target's
     /// (the window around the prior is searched first); a prior far from any target,
     /// an empty one, one outside the frame and one of the whole frame give the answer
     /// without a prior (the whole frame is searched).
     #[test]
     fn tracking_keeps_the_prior_target_and_falls_back_to_the_frame() {
-        let strong = (60usize, 60usize, 120usize, 110usize, 3000u16);
-        let weak = (230usize, 150usize, 270usize, 190usize, 1500u16);
+        let (strong, weak) = (STRONG_BLOCK, WEAK_BLOCK);
         let px = blocks_frame(&[strong, weak]);
         let frame = Frame::reference(&px).unwrap();
         let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
@@ -2180,9 +2185,7 @@ mod tests {
     /// answer without a look.
     #[test]
     fn the_fast_path_keeps_a_target_that_looks_the_same_and_nothing_else() {
-        let strong = (60usize, 60usize, 120usize, 110usize, 3000u16);
-        let weak = (230usize, 150usize, 270usize, 190usize, 1500u16);
-        let px = blocks_frame(&[strong, weak]);
+        let px = blocks_frame(&[STRONG_BLOCK, WEAK_BLOCK]);
         let frame = Frame::reference(&px).unwrap();
         let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
         let truth = Roi::new(230, 150, 270, 190);
@@ -2201,38 +2204,29 @@ mod tests {
         // The next call without a look: the flag goes.
         det.detect(&frame, &mut scratch).unwrap();
         assert!(!scratch.work().tracked());
+        // `det` with `look` on `frame`: the search decides (the answer without it).
+        let mut search_decides = |det: AutoV2, look: look::Look, frame: &Frame<'_>| {
+            let want = det.detect(frame, &mut scratch).unwrap();
+            let got = det
+                .with_look(Some(look))
+                .detect(frame, &mut scratch)
+                .unwrap();
+            assert!(!scratch.work().tracked(), "{got:?}");
+            assert_eq!(got, want);
+        };
         // The block gone: the prior lies on the background.
-        let gone_px = blocks_frame(&[strong]);
-        let gone = Frame::reference(&gone_px).unwrap();
-        let want = det.detect(&gone, &mut scratch).unwrap();
-        let got = det
-            .with_look(Some(last))
-            .detect(&gone, &mut scratch)
-            .unwrap();
-        assert!(!scratch.work().tracked());
-        assert_eq!(got, want);
+        let gone_px = blocks_frame(&[STRONG_BLOCK]);
+        search_decides(det, last, &Frame::reference(&gone_px).unwrap());
         // The prior on the strong block (3 000 DN above the background against the weak
         // one's 1 500).
         let on_strong = AutoV2::default().with_prior(Some(Roi::new(62, 62, 118, 108)));
-        let want = on_strong.detect(&frame, &mut scratch).unwrap();
-        let got = on_strong
-            .with_look(Some(last))
-            .detect(&frame, &mut scratch)
-            .unwrap();
-        assert!(!scratch.work().tracked());
-        assert_eq!(got, want);
-        // A look that did not stand out: the search decides.
+        search_decides(on_strong, last, &frame);
+        // A look that did not stand out.
         let faint = look::Look {
             level_dn: last.ring_dn + 1,
             ..last
         };
-        let want = det.detect(&frame, &mut scratch).unwrap();
-        let got = det
-            .with_look(Some(faint))
-            .detect(&frame, &mut scratch)
-            .unwrap();
-        assert!(!scratch.work().tracked());
-        assert_eq!(got, want);
+        search_decides(det, faint, &frame);
     }
 
     /// A frame of deep space as a real camera shows it: a 2 000 DN pedestal, a shading
