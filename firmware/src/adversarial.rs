@@ -26,7 +26,6 @@ use core::fmt;
 
 use tirroi_core::Roi;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
-use tirroi_core::roi::auto::learned::look::Look;
 
 use crate::BITS;
 use crate::frames::FRAMES;
@@ -220,17 +219,6 @@ pub const AUTO_V2_PRIORS: [Roi; PRIORS.len() + LARGE_WINDOW_PRIORS.len()] = {
         i += 1;
     }
     all
-};
-
-/// The look `auto-v2` tracks with on every case ([`AUTO_V2_PRIORS`]): distinct under
-/// any noise below 32 768 DN (a departure of 65 535 DN) and matched by no box of a
-/// frame of up to 15 bits (that needs a departure of half of it), so the fast tracking
-/// path runs to its end and is refused, and the window and the whole frame are then
-/// searched: the most a call with a prior and a look can cost.
-pub const REFUSED_LOOK: Look = Look {
-    level_dn: u16::MAX,
-    ring_dn: 0,
-    side_dn: [Some(0); 4],
 };
 
 /// xorshift64* (Vigna 2016): a fixed, tiny generator, so every target makes the same

@@ -26,9 +26,10 @@ mod target {
     use cortex_m_semihosting::{debug, hprintln};
     use panic_semihosting as _;
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+    use tirroi_core::roi::auto::learned::look::Look;
     use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
     use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
-    use tirroi_firmware::adversarial::{self, AUTO_V2_PRIORS, PRIORS, REFUSED_LOOK};
+    use tirroi_firmware::adversarial::{self, AUTO_V2_PRIORS, PRIORS};
     use tirroi_firmware::systick::{self, ticks};
     use tirroi_firmware::{BITS, DEMO_METHODS, Detectors};
 
@@ -137,22 +138,31 @@ mod target {
                     continue;
                 }
                 for &prior in priors {
-                    // `auto-v2` with a look no box can match: its fast path runs
-                    // to the end and is refused, then the window and the frame are
-                    // searched (the most a call with a prior can cost).
-                    let look = (method == Method::AutoV2).then_some(REFUSED_LOOK);
-                    let (result, n) =
-                        count(overhead, || DETECTORS.track(method, prior, look, &frame));
-                    failed |= result.is_err();
-                    calls += 1;
-                    hprintln!(
-                        "worst case={case} method={method}+prior prior={},{},{},{} instructions={n} box={}",
-                        prior.x0,
-                        prior.y0,
-                        prior.x1,
-                        prior.y1,
-                        BoxOf(&result)
-                    );
+                    // `auto-v2` also with the prior's own look on the frame: its
+                    // place matches, so the fast path refines (the blob, then the
+                    // prior's cells) and its box stands or is refused, and then the
+                    // window and the frame are searched (the most a call with a prior
+                    // can cost).
+                    let own = Look::measure(&frame, prior);
+                    let looks: &[(Option<Look>, &str)] = if method == Method::AutoV2 {
+                        &[(None, "none"), (own, "own")]
+                    } else {
+                        &[(None, "none")]
+                    };
+                    for &(look, look_name) in looks {
+                        let (result, n) =
+                            count(overhead, || DETECTORS.track(method, prior, look, &frame));
+                        failed |= result.is_err();
+                        calls += 1;
+                        hprintln!(
+                            "worst case={case} method={method}+prior prior={},{},{},{} look={look_name} instructions={n} box={}",
+                            prior.x0,
+                            prior.y0,
+                            prior.x1,
+                            prior.y1,
+                            BoxOf(&result)
+                        );
+                    }
                 }
             }
             // `auto` within a work budget: without a prior and with each prior, the

@@ -68,10 +68,11 @@ pub struct AutoV2 {
     /// The look of the prior's target on the last frame ([`look::Look::measure`] of
     /// the last box), or `None`. With a prior and a look, a fast path runs first: the
     /// prior's cells taken for the target's and refined by stages 5–8 in a window
-    /// around it (the classifier does not run); its box stands when it stays in the
-    /// window, follows the prior ([`TRACK_FAST_MIN_IOU_PERMILLE`],
-    /// [`TRACK_FAST_SIDE_SLACK_PX`]), the prior's place still looks as the last look
-    /// says ([`look::Look::matches`]) and the box stands out on every side
+    /// around it (the classifier does not run; a saturated blob there whose box
+    /// follows the prior is taken instead, as stage 2b boxes it) when the prior's place
+    /// still looks as the last look says ([`look::Look::matches`]); its box stands when
+    /// it stays in the window, follows the prior ([`TRACK_FAST_MIN_IOU_PERMILLE`],
+    /// [`TRACK_FAST_SIDE_SLACK_PX`]) and stands out on every side
     /// ([`look::Look::stands_out`]), with confidence [`TRACKED_SCORE_PERMILLE`];
     /// otherwise the call goes on as with the prior alone.
     pub look: Option<look::Look>,
@@ -246,11 +247,11 @@ fn follows_prior(p: &Roi, r: &Roi) -> bool {
 
 /// Confidence of a box of the fast tracking path, ‰: its hit rate (IoU ≥ ½) on family
 /// A (seed 7001: famA, paper A, fixtures A, famAF, famAT) with `tirroi eval --track
-/// jitter`, 686 of 702 (12 of the 16 misses far targets of famAF, 65 of 77 there);
-/// held out 572 of 575 (`docs/detectors.md` § Session 41). A P(hit) given a prior on
+/// jitter`, 710 of 726 (12 of the 16 misses far targets of famAF, 67 of 79 there);
+/// held out 596 of 599 (`docs/detectors.md` § Session 41). A P(hit) given a prior on
 /// the target: a wrong prior whose box passes the look's checks is not in it (no false
 /// alarm added on family A's `--track sequence`).
-pub const TRACKED_SCORE_PERMILLE: u16 = 977;
+pub const TRACKED_SCORE_PERMILLE: u16 = 978;
 
 /// The answer "no target": no box, confidence 0.
 const NO_TARGET: Detection = Detection {
@@ -491,6 +492,18 @@ impl<C: FrameCapacity> AutoV2Work<C> {
     /// (its box, if any, is then the stage's); `None` otherwise.
     pub fn deep_space(&self) -> Option<smooth::DeepSpace> {
         self.deep_space
+    }
+
+    /// `d`, the fast tracking path's box, as the call's answer: the flag set and what
+    /// the other stages would have left cleared (nothing ran; telemetry reads these).
+    fn tracked_box(&mut self, d: Detection) -> Detection {
+        self.tracked = true;
+        self.winner = None;
+        self.blob = None;
+        self.blob_won = false;
+        self.deep_space = None;
+        self.spot = None;
+        d
     }
 
     /// Whether the last frame's box came from the fast tracking path
@@ -1053,12 +1066,13 @@ impl AutoV2 {
         self.run_in(frame, work, Window::full(frame))
     }
 
-    /// The fast tracking path ([`AutoV2::look`]): the prior's cells refined by stages
-    /// 5–8 in a window around the prior; `Some` when the box stays in the window,
-    /// follows the prior ([`follows_prior`]), the prior's place looks as it did and the
-    /// box stands out on every side, else `None` (the search decides). Costs the
-    /// window's noise and cell planes, the refinement and two looks (the prior's place
-    /// and the box, each with its strips).
+    /// The fast tracking path ([`AutoV2::look`]): in a window around the prior, when
+    /// the prior's place still looks as the last look says, the window's largest
+    /// saturated blob refined as stage 2b's (when its box follows the prior), else the
+    /// prior's cells refined by stages 5–8; `Some` when that box stays in the window,
+    /// follows the prior ([`follows_prior`]) and stands out on every side, else `None`
+    /// (the search decides). Costs the window's noise and cell planes, at most two
+    /// refinements and the looks of the prior's place and the boxes.
     #[inline(never)]
     fn track_fast<C: FrameCapacity>(
         &self,
@@ -1079,11 +1093,42 @@ impl AutoV2 {
             return None;
         }
         let (plane8, lv) = prepare_cells(frame, work, win);
-        if !last.is_distinct(lv.sigma) {
+        // The last box's place on this frame still looks as the last look says (before
+        // any refinement: a refused place costs the cell planes only).
+        if !last.matches(&look::Look::measure(frame, p)?, lv.sigma) {
             return None;
         }
-        // The cells the prior overlaps as the only target cells (code 255; `labels4`
-        // held the saturated counts, which the fast path does not read).
+        // A box found here stands when it stays in the window, follows the prior and
+        // stands out from its strips on every side.
+        let accepts = |r: &Roi| {
+            win.keeps(frame, &p, r)
+                && follows_prior(&p, r)
+                && look::Look::measure(frame, *r)
+                    .is_some_and(|now| now.stands_out(last.departure_dn()))
+        };
+        // A saturated target: the window's largest saturated blob, as stage 2b boxes it
+        // (the body stage skipped, the optics' reach cut), when its box follows the
+        // prior; the blob's cells and the prior's differ by the target's halo.
+        if let Some((winner, _)) =
+            self.blob_stage(frame, work, win, plane8, lv, Counts::FromPrepare)
+        {
+            let d = self.finish(
+                frame,
+                work,
+                win,
+                plane8,
+                lv,
+                winner,
+                TRACKED_SCORE_PERMILLE,
+                false,
+            );
+            if d.roi.is_some_and(|r| accepts(&r)) {
+                return Some(work.tracked_box(d));
+            }
+        }
+        // Otherwise the cells the prior overlaps as the only target cells (code 255;
+        // `labels4` held the saturated counts, read by the blob above; `mean_dn` and
+        // `step_code`, which the refinement reads, are the window's still).
         let n8 = plane8.0 * plane8.1;
         let codes = work.labels4.as_mut().get_mut(..n8)?;
         let (x0, y0) = (usize::from(p.x0), usize::from(p.y0));
@@ -1106,27 +1151,9 @@ impl AutoV2 {
             TRACKED_SCORE_PERMILLE,
             false,
         );
-        let r = d.roi?;
-        // The last box's place on this frame, and the new box.
-        let (under, now) = (
-            look::Look::measure(frame, p)?,
-            look::Look::measure(frame, r)?,
-        );
-        if !(win.keeps(frame, &p, &r)
-            && follows_prior(&p, &r)
-            && last.matches(&under, lv.sigma)
-            && now.stands_out(last.departure_dn()))
-        {
-            return None;
-        }
-        // What the other stages would have left: nothing (telemetry reads the flag).
-        work.tracked = true;
-        work.winner = None;
-        work.blob = None;
-        work.blob_won = false;
-        work.deep_space = None;
-        work.spot = None;
-        Some(d)
+        d.roi
+            .is_some_and(|r| accepts(&r))
+            .then(|| work.tracked_box(d))
     }
 
     /// Every stage on the frame's window `win` (the whole frame, or the tracking
