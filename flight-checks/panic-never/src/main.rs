@@ -26,6 +26,7 @@ use core::hint::black_box;
 #[allow(unused_imports)]
 use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
 #[allow(unused_imports)]
+use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::{Frame, Method, Roi};
 #[allow(unused_imports)]
 use tirroi_firmware::{Detectors, Workspace, synth};
@@ -57,7 +58,8 @@ fn detect(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
 }
 
 /// Runs a tracker (`auto`, `auto-v2`) through the firmware's tracking call on an
-/// opaque frame with an opaque prior (any box, also one outside the frame).
+/// opaque frame with an opaque prior (any box, also one outside the frame) and an
+/// opaque look of the last box (any, or none: `auto-v2`'s fast path and its search).
 #[allow(dead_code)]
 #[inline(never)]
 fn track(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
@@ -70,7 +72,12 @@ fn track(detectors: &mut Detectors, method: Method, pixels: &[u16]) {
             black_box(0),
             black_box(0),
         ));
-        let _ = black_box(detectors.track(method, prior, &frame));
+        let look = black_box(Some(Look {
+            level_dn: black_box(0),
+            ring_dn: black_box(0),
+            side_dn: black_box([None; 4]),
+        }));
+        let _ = black_box(detectors.track(method, prior, black_box(look), &frame));
     }
 }
 

@@ -47,9 +47,6 @@ pub const LEVEL_SHARE_PERMILLE: i64 = 500;
 /// Mean DN (clamped to the frame's top DN) of the pixels of `r`, a box inside the
 /// frame, and their count; `None` when it is empty.
 fn mean_dn(frame: &Frame<'_>, r: Roi) -> Option<(u16, u64)> {
-    if r.is_empty() {
-        return None;
-    }
     let max_dn = frame.max_dn();
     let mut sum = 0u64;
     for y in r.y0..r.y1 {
@@ -58,7 +55,8 @@ fn mean_dn(frame: &Frame<'_>, r: Roi) -> Option<(u16, u64)> {
         sum += row.iter().map(|&v| u64::from(v.min(max_dn))).sum::<u64>();
     }
     let n = u64::from(r.area());
-    Some(((sum / n) as u16, n))
+    // `checked_div`: an empty box has no mean (and the flight build no panic path).
+    Some((sum.checked_div(n)? as u16, n))
 }
 
 /// The look of a box: mean DN inside it and in the strips of [`RING_PX`] along each of
@@ -120,12 +118,10 @@ impl Look {
                 px += n;
             }
         }
-        if px == 0 {
-            return None;
-        }
+        // No strip inside the frame: no ring.
         Some(Look {
             level_dn: level,
-            ring_dn: (sum / px) as u16,
+            ring_dn: sum.checked_div(px)? as u16,
             side_dn,
         })
     }
