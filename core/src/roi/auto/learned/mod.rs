@@ -1106,12 +1106,8 @@ impl AutoV2 {
                 && look::Look::measure(frame, *r)
                     .is_some_and(|now| now.stands_out(last.departure_dn()))
         };
-        // A saturated target: the window's largest saturated blob, as stage 2b boxes it
-        // (the body stage skipped, the optics' reach cut), when its box follows the
-        // prior; the blob's cells and the prior's differ by the target's halo.
-        if let Some((winner, _)) =
-            self.blob_stage(frame, work, win, plane8, lv, Counts::FromPrepare)
-        {
+        // A winner refined by stages 5–8 in the window, kept when its box is accepted.
+        let refine = |work: &mut AutoV2Work<C>, winner| {
             let d = self.finish(
                 frame,
                 work,
@@ -1122,8 +1118,18 @@ impl AutoV2 {
                 TRACKED_SCORE_PERMILLE,
                 false,
             );
-            if d.roi.is_some_and(|r| accepts(&r)) {
-                return Some(work.tracked_box(d));
+            d.roi
+                .is_some_and(|r| accepts(&r))
+                .then(|| work.tracked_box(d))
+        };
+        // A saturated target: the window's largest saturated blob, as stage 2b boxes it
+        // (the body stage skipped, the optics' reach cut), when its box follows the
+        // prior; the blob's cells and the prior's differ by the target's halo.
+        if let Some((winner, _)) =
+            self.blob_stage(frame, work, win, plane8, lv, Counts::FromPrepare)
+        {
+            if let Some(d) = refine(work, winner) {
+                return Some(d);
             }
         }
         // Otherwise the cells the prior overlaps as the only target cells (code 255;
@@ -1141,19 +1147,7 @@ impl AutoV2 {
             *code = if overlaps { u8::MAX } else { 0 };
         }
         let winner = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
-        let d = self.finish(
-            frame,
-            work,
-            win,
-            plane8,
-            lv,
-            winner,
-            TRACKED_SCORE_PERMILLE,
-            false,
-        );
-        d.roi
-            .is_some_and(|r| accepts(&r))
-            .then(|| work.tracked_box(d))
+        refine(work, winner)
     }
 
     /// Every stage on the frame's window `win` (the whole frame, or the tracking
