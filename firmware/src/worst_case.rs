@@ -144,10 +144,11 @@ mod target {
                     // window and the frame are searched (the most a call with a prior
                     // can cost).
                     let own = Look::measure(&frame, prior);
+                    // (`auto` has no look: its lines name none.)
                     let looks: &[(Option<Look>, &str)] = if method == Method::AutoV2 {
-                        &[(None, "none"), (own, "own")]
+                        &[(None, " look=none"), (own, " look=own")]
                     } else {
-                        &[(None, "none")]
+                        &[(None, "")]
                     };
                     for &(look, look_name) in looks {
                         let (result, n) =
@@ -155,7 +156,7 @@ mod target {
                         failed |= result.is_err();
                         calls += 1;
                         hprintln!(
-                            "worst case={case} method={method}+prior prior={},{},{},{} look={look_name} instructions={n} box={}",
+                            "worst case={case} method={method}+prior prior={},{},{},{}{look_name} instructions={n} box={}",
                             prior.x0,
                             prior.y0,
                             prior.x1,
