@@ -227,6 +227,19 @@ pub const TRACK_FAST_SIDE_SLACK_PX: u32 = 4;
 /// See [`TRACK_FAST_SIDE_SLACK_PX`], ‰.
 pub const TRACK_FAST_SIDE_SLACK_PERMILLE: u32 = 100;
 
+/// A tracker's window ([`Window::around`] `prior` by `margin`), `None` when it covers
+/// more than [`TRACK_MAX_WINDOW_PERMILLE`] of the frame: the window search's and the
+/// fast path's cap.
+fn capped_window(
+    frame: &Frame<'_>,
+    prior: Roi,
+    margin: impl FnOnce(Roi) -> usize,
+) -> Option<(Roi, Window)> {
+    let (p, win) = Window::around(frame, prior, margin)?;
+    let frame_px = frame.width() * frame.height();
+    (win.w * win.h * 1000 <= frame_px * TRACK_MAX_WINDOW_PERMILLE).then_some((p, win))
+}
+
 /// Whether the fast path's box `r` follows the prior `p` (both cut to the frame): an
 /// IoU of [`TRACK_FAST_MIN_IOU_PERMILLE`] or more and every side within
 /// [`TRACK_FAST_SIDE_SLACK_PX`] + [`TRACK_FAST_SIDE_SLACK_PERMILLE`] of the prior's.
@@ -1043,11 +1056,9 @@ impl AutoV2 {
     /// (cut to the frame) or when the window is over [`TRACK_MAX_WINDOW_PERMILLE`] of
     /// the frame.
     fn tracking_window(&self, frame: &Frame<'_>) -> Option<(Roi, Window)> {
-        let (p, win) = Window::around(frame, self.prior?, |p| {
+        capped_window(frame, self.prior?, |p| {
             TRACK_MARGIN_PX + usize::from(p.width().max(p.height()))
-        })?;
-        let frame_px = frame.width() * frame.height();
-        (win.w * win.h * 1000 <= frame_px * TRACK_MAX_WINDOW_PERMILLE).then_some((p, win))
+        })
     }
 
     /// The detection: in the tracking window first when there is a prior (its box
@@ -1083,15 +1094,12 @@ impl AutoV2 {
         if TRACKED_SCORE_PERMILLE < self.min_score_permille {
             return None;
         }
-        let (p, win) = Window::around(frame, self.prior?, |p| {
+        // Not over half the frame (the search decides, as for the window of the prior
+        // alone: a refused box pays both).
+        let (p, win) = capped_window(frame, self.prior?, |p| {
             TRACK_FAST_MARGIN_PX
                 + usize::from(p.width().max(p.height())) / TRACK_FAST_MARGIN_DIVISOR
         })?;
-        // A window over half the frame saves less than half a search (and a refused
-        // box pays both): the search decides, as for the window of the prior alone.
-        if win.w * win.h * 1000 > frame.width() * frame.height() * TRACK_MAX_WINDOW_PERMILLE {
-            return None;
-        }
         let (plane8, lv) = prepare_cells(frame, work, win);
         // The last box's place on this frame still looks as the last look says (before
         // any refinement: a refused place costs the cell planes only).
