@@ -754,6 +754,98 @@ fn multi_page_tiff_and_bits_below_the_data() {
     );
 }
 
+/// The stronger of [`blocks_frame`]'s two targets in the tracking tests, px.
+const STRONG_BLOCK: [u32; 4] = [60, 60, 120, 110];
+
+/// A 328 × 248 frame of 2 000 DN with noise (σ ≈ 9 DN, a fixed xorshift sequence) and
+/// each block `([x0, y0, x1, y1), DN)` raised by its DN (the first block that holds a
+/// pixel wins).
+fn blocks_frame(blocks: &[([u32; 4], u32)]) -> image::ImageBuffer<image::Luma<u16>, Vec<u16>> {
+    let mut state = 0x2545_f491u32;
+    image::ImageBuffer::from_fn(328, 248, |x, y| {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise =
+            (state & 15) + ((state >> 8) & 15) + ((state >> 16) & 15) + ((state >> 24) & 15);
+        let inside = |b: &[u32; 4]| (b[0]..b[2]).contains(&x) && (b[1]..b[3]).contains(&y);
+        let lift = blocks
+            .iter()
+            .find(|(b, _)| inside(b))
+            .map_or(0, |&(_, dn)| dn);
+        image::Luma([(2000 + noise + lift) as u16])
+    })
+}
+
+/// A `sequence` column (rendered approach sequences, `render --preset
+/// realistic-approach`) makes `eval --track sequence` start each sequence without a
+/// prior: a tracker that boxed the weaker of two targets on a frame where it was alone
+/// carries that box into the next frame of the same sequence and boxes the weaker
+/// target there too, but on the first frame of a new sequence it searches the whole
+/// frame and boxes the stronger one.
+#[test]
+fn eval_track_sequence_starts_each_sequence_without_a_prior() {
+    let dir = tempfile::tempdir().unwrap();
+    let weak = [230u32, 150, 270, 190];
+    blocks_frame(&[(weak, 1500)])
+        .save(dir.path().join("a-weak-alone.png"))
+        .unwrap();
+    blocks_frame(&[(STRONG_BLOCK, 3000), (weak, 1500)])
+        .save(dir.path().join("b-both.png"))
+        .unwrap();
+    let iou = |b: &[String], t: [u32; 4]| {
+        let b: [u32; 4] = [0, 1, 2, 3].map(|k| b[k].parse().unwrap());
+        let ix = b[2].min(t[2]).saturating_sub(b[0].max(t[0]));
+        let iy = b[3].min(t[3]).saturating_sub(b[1].max(t[1]));
+        let area = |r: [u32; 4]| (r[2] - r[0]) * (r[3] - r[1]);
+        f64::from(ix * iy) / f64::from(area(b) + area(t) - ix * iy)
+    };
+    for (second, carried) in [("0,1", true), ("1,0", false)] {
+        let w = weak.map(|v| v.to_string()).join(",");
+        fs::write(
+            dir.path().join("truth.csv"),
+            format!("file,x0,y0,x1,y1,sequence,frame\na-weak-alone.png,{w},0,0\nb-both.png,{w},{second}\n"),
+        )
+        .unwrap();
+        let out = dir.path().join(format!("eval-{carried}"));
+        ok(&run(&[
+            "eval",
+            "--images",
+            s(dir.path()),
+            "--method",
+            "all",
+            "--track",
+            "sequence",
+            "--out",
+            s(&out),
+        ]));
+        let (h, rows) = csv(&out.join("scores.csv"));
+        let (fc, mc, x0, y1) = (
+            col(&h, "file"),
+            col(&h, "method"),
+            col(&h, "x0"),
+            col(&h, "y1"),
+        );
+        for method in ["auto", "auto-v2"] {
+            let boxed = |file: &str| {
+                let r = rows
+                    .iter()
+                    .find(|r| r[fc] == file && r[mc] == method)
+                    .unwrap_or_else(|| panic!("{file} {method} in scores.csv"));
+                r[x0..=y1].to_vec()
+            };
+            assert!(iou(&boxed("a-weak-alone.png"), weak) > 0.9, "{method}");
+            let b = boxed("b-both.png");
+            let (on_weak, on_strong) = (iou(&b, weak), iou(&b, STRONG_BLOCK));
+            if carried {
+                assert!(on_weak > 0.9, "{method} carried: {b:?}");
+            } else {
+                assert!(on_strong > 0.9, "{method} new sequence: {b:?}");
+            }
+        }
+    }
+}
+
 /// `eval --track jitter` and `--track sequence` give both trackers (`auto`, `auto-v2`)
 /// their prior: each box in `scores.csv` is the library tracker's with the prior the
 /// mode defines (jitter: `jittered_prior` of the truth, and for `auto-v2` its look on
@@ -774,24 +866,9 @@ fn eval_track_hands_both_trackers_their_priors() {
     // A frame with two targets, the truth the weaker one: only a tracker handed a prior
     // near it boxes it (noise σ ≈ 9 DN on 2 000 DN; blocks 3 000 and 1 500 DN above).
     let weak = [230u16, 150, 270, 190];
-    let mut state = 0x2545_f491u32;
-    let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(328, 248, |x, y| {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        let noise =
-            (state & 15) + ((state >> 8) & 15) + ((state >> 16) & 15) + ((state >> 24) & 15);
-        let inside = |b: [u32; 4]| (b[0]..b[2]).contains(&x) && (b[1]..b[3]).contains(&y);
-        let lift = if inside([60, 60, 120, 110]) {
-            3000
-        } else if inside(weak.map(u32::from)) {
-            1500
-        } else {
-            0
-        };
-        image::Luma([(2000 + noise + lift) as u16])
-    });
-    img.save(dir.path().join("two-targets.png")).unwrap();
+    blocks_frame(&[(STRONG_BLOCK, 3000), (weak.map(u32::from), 1500)])
+        .save(dir.path().join("two-targets.png"))
+        .unwrap();
     let mut text = fs::read_to_string(dir.path().join("truth.csv")).unwrap();
     text.push_str(&format!(
         "two-targets.png,{},{},{},{}\n",

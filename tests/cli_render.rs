@@ -109,7 +109,10 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
 
     let truth = String::from_utf8(fa["/truth.csv"].clone()).unwrap();
     let mut lines = truth.lines();
-    assert!(lines.next().unwrap().starts_with("file,x0,y0,x1,y1,"));
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("file,x0,y0,x1,y1,"));
+    // No sequence in the file, no sequence columns.
+    assert!(header.ends_with(",visible_share"), "{header}");
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 6);
     for r in &rows {
@@ -171,6 +174,75 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     assert!(meta[0]["noise_sigma_dn"].as_f64().unwrap() > 0.0);
     let t = &meta[3]["target_temperature_k"];
     assert!(t[0].as_f64().unwrap() < t[1].as_f64().unwrap());
+}
+
+/// Approach sequences (scene `sequence`): `truth.csv` ends with `sequence,frame`, the
+/// images of a sequence are numbered in it, the range closes frame by frame as the
+/// scene says (so the target's box grows), and `metadata.jsonl` carries both numbers.
+#[test]
+fn a_sequence_is_labelled_frame_by_frame() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = tmp.path().join("approach.toml");
+    fs::write(
+        &config,
+        r#"
+[dataset]
+seed = 5
+thermal_states = 2
+
+[[scene]]
+count = 6
+range_m = 40.0
+earth = false
+offset_px = [0.0, 0.0]
+sequence = { frames = 3, range_end_m = 20.0, drift_px = 30.0, spin_deg = 20.0 }
+"#,
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let report = render_into(&config, &out, "2", &[]);
+    assert!(report.contains("6 images rendered"), "{report}");
+    let truth = fs::read_to_string(out.join("truth.csv")).unwrap();
+    let mut lines = truth.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header[header.len() - 2..], ["sequence", "frame"]);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (seq, frame, range) = (at("sequence"), at("frame"), at("range_m"));
+    let numbered: Vec<(&str, &str)> = rows.iter().map(|r| (r[seq], r[frame])).collect();
+    assert_eq!(
+        numbered,
+        [
+            ("0", "0"),
+            ("0", "1"),
+            ("0", "2"),
+            ("1", "0"),
+            ("1", "1"),
+            ("1", "2")
+        ]
+    );
+    for run in rows.chunks(3) {
+        let ranges: Vec<f64> = run.iter().map(|r| r[range].parse().unwrap()).collect();
+        assert_eq!(ranges, [40.0, 30.0, 20.0]);
+        let width = |r: &Vec<&str>| r[3].parse::<u32>().unwrap() - r[1].parse::<u32>().unwrap();
+        assert!(width(&run[0]) < width(&run[1]) && width(&run[1]) < width(&run[2]));
+    }
+    let meta: Vec<serde_json::Value> = fs::read_to_string(out.join("metadata.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(
+        (meta[4]["sequence"].as_u64(), meta[4]["frame"].as_u64()),
+        (Some(1), Some(1))
+    );
+    // The target's centre drifts the scene's 30 px from the first frame to the last.
+    let centre = |m: &serde_json::Value| [0, 1].map(|k| m["offset_px"][k].as_f64().unwrap());
+    let (a, b) = (centre(&meta[0]), centre(&meta[2]));
+    assert!(
+        ((b[0] - a[0]).hypot(b[1] - a[1]) - 30.0).abs() < 1e-6,
+        "{a:?} {b:?}"
+    );
 }
 
 #[test]

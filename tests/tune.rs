@@ -22,6 +22,7 @@ fn row(file: &str) -> TruthRow {
         range_m: None,
         bits: None,
         signal_to_clutter: None,
+        sequence: None,
     }
 }
 
@@ -148,6 +149,7 @@ fn write_dataset(dir: &Path, n: usize) -> Vec<TruthRow> {
             range_m: Some(20.0 + i as f64),
             bits: None,
             signal_to_clutter: None,
+            sequence: None,
         });
     }
     std::fs::write(dir.join("truth.csv"), csv).unwrap();

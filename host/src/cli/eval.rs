@@ -64,7 +64,9 @@ pub struct EvalArgs {
     /// Tracking prior for auto and auto-v2: off (search every frame whole); jitter
     /// (the truth box moved by up to 4 px and each side by up to 10 %, as a tracker
     /// would hand it over); sequence (frames in file-name order, each frame's prior is
-    /// the tracker's own box on the previous one; one thread).
+    /// the tracker's own box on the previous one; a `sequence` column in truth.csv, as
+    /// `render --preset realistic-approach` writes, starts each sequence without one;
+    /// one thread).
     #[arg(long, default_value = "off", value_parser = parse_track)]
     pub track: scoring::Track,
     /// Which truth box scores: half (x0,y0,x1,y1: pixels covered at least the

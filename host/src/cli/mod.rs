@@ -153,8 +153,9 @@ pub enum Command {
     /// metadata.jsonl (optionally masks/ and preview/), from a preset or a TOML file.
     ///
     /// Presets (`--list-presets`): paper (12 000 images, Section 4.1), tango (1 000,
-    /// Section 5), quick (24), realistic (12 000), realistic-tango (1 000). The same
-    /// seed gives the same bytes. A manifest (tirroi-run.json) records the run: a
+    /// Section 5), quick (24), realistic (12 000), realistic-tango (1 000),
+    /// realistic-approach (2 448: sequences of 24 frames). The same seed gives the same
+    /// bytes. A manifest (tirroi-run.json) records the run: a
     /// non-empty directory that is not a tirroi run is never written to, a previous
     /// run is replaced only with --force, and --resume continues a stopped one (Ctrl-C
     /// prints the command). --shard I/N and `tirroi merge` split a run over machines.

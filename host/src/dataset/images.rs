@@ -127,6 +127,13 @@ pub struct ImageRecord {
     pub eclipse_duration_s: Option<f64>,
     /// Dataset seed.
     pub dataset_seed: u64,
+    /// The approach sequence the image belongs to (scene `sequence`; 0, 1, … in image
+    /// order); absent outside one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<usize>,
+    /// The image's frame within its sequence, 0 = the first; absent outside one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<usize>,
 }
 
 fn default_bits() -> u8 {
@@ -234,6 +241,8 @@ pub(super) fn record(
         orbit_time_s: thermal.orbit_time_s,
         eclipse_duration_s: thermal.eclipse_duration_s,
         dataset_seed: file.dataset.seed,
+        sequence: plan.sequence.map(|q| q.id),
+        frame: plan.sequence.map(|q| q.frame),
     }
 }
 

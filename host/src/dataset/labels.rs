@@ -13,13 +13,25 @@ use crate::world::scene::SceneFile;
 /// visible share ([`crate::dataset`] module docs). Test sets ([`crate::dataset::testset`]) write the same.
 pub const TRUTH_CSV_HEADER: &str = "file,x0,y0,x1,y1,mode,scale,target,material,illumination,range_m,earth_fraction,noise_seed,bits,x0_quarter,y0_quarter,x1_quarter,y1_quarter,signal_to_clutter,visible_share\n";
 
+/// The columns `truth.csv` ends with when the dataset has approach sequences (scene
+/// `sequence`), after [`TRUTH_CSV_HEADER`]'s: the sequence (0, 1, …) and the frame in
+/// it, empty for an image outside one. `tirroi eval --track sequence` starts each
+/// sequence without a prior.
+pub const SEQUENCE_COLUMNS: &str = ",sequence,frame\n";
+
 /// Writes `truth.csv`, `coco.json` and `metadata.jsonl` (each atomically).
 pub(super) fn write_labels<'a>(
     file: &SceneFile,
     dir: &Path,
     records: impl Iterator<Item = &'a ImageRecord>,
 ) -> Result<(), DatasetError> {
+    // Sequences add their two columns (every other dataset keeps its bytes).
+    let sequences = file.scenes.iter().any(|s| s.sequence.is_some());
     let mut csv = String::from(TRUTH_CSV_HEADER);
+    if sequences {
+        csv.pop();
+        csv.push_str(SEQUENCE_COLUMNS);
+    }
     let mut jsonl = String::new();
     let mut images = Vec::new();
     let mut annotations = Vec::new();
@@ -51,6 +63,12 @@ pub(super) fn write_labels<'a>(
                 .map_or(String::new(), |s| format!("{s:.4}")),
             r.visible_share.map_or(String::new(), |s| format!("{s:.4}")),
         ));
+        if sequences {
+            // Before the newline: `,sequence,frame` (empty outside a sequence).
+            csv.pop();
+            let opt = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
+            csv.push_str(&format!(",{},{}\n", opt(r.sequence), opt(r.frame)));
+        }
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');
         images.push(serde_json::json!({

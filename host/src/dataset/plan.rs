@@ -6,9 +6,9 @@ use rand_pcg::Pcg64;
 
 use crate::seed::splitmix64;
 use crate::world::constants::EARTH_DISTANCE_M;
-use crate::world::geom::{Rotation, Vec3, normalize, scale};
+use crate::world::geom::{Rotation, Vec3, norm, normalize, scale};
 use crate::world::scene::{
-    Illumination, Mode, RadiometryReadout, SceneFile, TargetModel, ThermalModel,
+    Illumination, Mode, RadiometryReadout, SceneFile, SequenceSpec, TargetModel, ThermalModel,
 };
 use crate::world::spacecraft::MaterialCase;
 use crate::world::spacecraft::thermal::Orbit;
@@ -62,6 +62,84 @@ pub struct ImagePlan {
     /// Whether the target is rendered (false: a no-target frame,
     /// [`SceneSpec::no_target_fraction`](crate::world::scene::SceneSpec::no_target_fraction)).
     pub has_target: bool,
+    /// The image's place in an approach sequence (scene `sequence`), `None` outside one.
+    pub sequence: Option<SequenceFrame>,
+}
+
+/// Where an image sits in an approach sequence
+/// ([`SequenceSpec`](crate::world::scene::SequenceSpec)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SequenceFrame {
+    /// The sequence: 0, 1, … over the dataset in image order.
+    pub id: usize,
+    /// The frame within it: 0 (the first) to `frames` − 1.
+    pub frame: usize,
+}
+
+/// How one pose of a sequence moves over it: each quantity reached linearly at the
+/// last frame (drawn once per sequence, [`sequence_motion`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SequenceMotion {
+    /// Frames in the sequence (≥ 2).
+    frames: usize,
+    /// Range at the last frame, m.
+    range_end_m: f64,
+    /// The target centre's image motion over the sequence, px.
+    drift_px: [f64; 2],
+    /// The target's turn over the sequence: axis (camera frame) and angle, rad.
+    spin: (Vec3, f64),
+    /// The ground's motion over the sequence: axis (Earth-fixed) and angle, rad.
+    earth_turn: (Vec3, f64),
+}
+
+impl SequenceMotion {
+    /// Share of the sequence behind frame `k`: 0 at the first frame, 1 at the last.
+    fn at(&self, k: usize) -> f64 {
+        k as f64 / (self.frames - 1).max(1) as f64
+    }
+}
+
+/// The motion of one sequence, drawn from `rng` after the pose's own draws: the range
+/// at its end, the drift (its direction turned back on an axis where the end would lie
+/// beyond `limit_px` of the frame centre), the spin axis and the ground's direction
+/// (perpendicular to the sub-camera point).
+fn sequence_motion(
+    rng: &mut Pcg64,
+    q: &SequenceSpec,
+    range_m: f64,
+    offset_px: [f64; 2],
+    limit_px: [f64; 2],
+    up_earth: Vec3,
+) -> SequenceMotion {
+    let range_end_m = q.range_end_m.map_or(range_m, |r| r.sample(rng.r#gen()));
+    let length = q.drift_px.sample(rng.r#gen());
+    let heading: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
+    let mut drift_px = [length * heading.cos(), length * heading.sin()];
+    for ((d, &o), &lim) in drift_px.iter_mut().zip(&offset_px).zip(&limit_px) {
+        if (o + *d).abs() > lim {
+            *d = -*d;
+        }
+    }
+    let spin = (
+        random_direction(rng),
+        q.spin_deg.sample(rng.r#gen()).to_radians(),
+    );
+    let side = random_direction(rng);
+    let mut axis = crate::world::geom::cross(up_earth, side);
+    if norm(axis) < 1e-9 {
+        axis = crate::world::geom::cross(up_earth, [1.0, 0.0, 0.0]);
+    }
+    let earth_turn = (
+        normalize(axis),
+        q.earth_drift_deg.sample(rng.r#gen()).to_radians(),
+    );
+    SequenceMotion {
+        frames: q.frames,
+        range_end_m,
+        drift_px,
+        spin,
+        earth_turn,
+    }
 }
 
 /// Where the Moon is and where its Sun is, camera frame.
@@ -241,6 +319,8 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
     let orbit = thermal_orbit(file);
     let transient = file.dataset.thermal == ThermalModel::Transient;
     let mut plans = Vec::with_capacity(file.image_count());
+    // Sequences planned so far (the next one's id).
+    let mut sequences = 0usize;
     for (si, spec) in file.scenes.iter().enumerate() {
         let scales: Vec<Option<u8>> = match spec.mode {
             Mode::Radiometry => vec![None],
@@ -251,9 +331,10 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
             TargetModel::Tango => vec![MaterialCase::Mono],
         };
         let lights = spec.illumination.values();
-        // Whole poses, and a last partial one (its first `count mod scales` scales)
-        // when the count is not a multiple of the scales.
-        let poses = spec.count.div_ceil(scales.len());
+        // Whole poses, and a last partial one (its first `count mod scales` scales, or
+        // frames of a sequence) when the count is not a multiple of them.
+        let frames = spec.sequence.map_or(1, |q| q.frames);
+        let poses = spec.count.div_ceil(scales.len() * frames);
         let kind_start = plans.len();
         let earth_distance_m = spec.earth_distance_km * 1e3;
         let disc_cos = (1.0 - (radius_m / earth_distance_m).powi(2)).sqrt();
@@ -269,11 +350,8 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 file.camera.width as f64 / 2.0 * spec.max_offset_fraction,
                 file.camera.height as f64 / 2.0 * spec.max_offset_fraction,
             ];
-            let offset_px = spec.offset_px.unwrap_or_else(|| {
-                let o = [
-                    rng.gen_range(-1.0..=1.0) * fov_half[0],
-                    rng.gen_range(-1.0..=1.0) * fov_half[1],
-                ];
+            // An edge-cut target's centre pulled back so that part of it stays in view.
+            let in_view = |o: [f64; 2], range_m: f64| {
                 if spec.max_offset_fraction > 1.0 {
                     let half = [
                         file.camera.width as f64 / 2.0,
@@ -284,6 +362,13 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 } else {
                     o
                 }
+            };
+            let offset_px = spec.offset_px.unwrap_or_else(|| {
+                let o = [
+                    rng.gen_range(-1.0..=1.0) * fov_half[0],
+                    rng.gen_range(-1.0..=1.0) * fov_half[1],
+                ];
+                in_view(o, range_m)
             });
             let off = spec
                 .earth_off_boresight_deg
@@ -360,6 +445,10 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     },
                 })
             });
+            // A sequence's motion draws last: the other draws keep their values.
+            let motion = spec
+                .sequence
+                .map(|q| sequence_motion(&mut rng, &q, range_m, offset_px, fov_half, up));
             let thermal = ThermalKey {
                 target: spec.target,
                 material,
@@ -369,37 +458,80 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                 earth_body_bits: earth_body.map(f64::to_bits),
                 orbit_time_bits: orbit_time_s.map(f64::to_bits),
             };
+            let sun_dir_camera = sun_body.map(|s| body_to_camera.apply(s));
             for (k, &scale) in scales.iter().enumerate() {
-                if plans.len() - kind_start == spec.count {
-                    break;
+                for frame in 0..frames {
+                    if plans.len() - kind_start == spec.count {
+                        break;
+                    }
+                    let index = plans.len();
+                    // Frame `frame` of the sequence (the pose itself outside one): range,
+                    // place, the target's turn and the ground's reached linearly; the Sun
+                    // stays where it is in the camera frame (the target turns, not the
+                    // chaser) and the temperatures stay the first frame's.
+                    let (range_m, offset_px, body_to_camera, camera_to_earth, sequence) =
+                        match motion {
+                            None => (range_m, offset_px, body_to_camera, camera_to_earth, None),
+                            Some(m) => {
+                                let f = m.at(frame);
+                                let r = range_m + (m.range_end_m - range_m) * f;
+                                let o = [
+                                    offset_px[0] + m.drift_px[0] * f,
+                                    offset_px[1] + m.drift_px[1] * f,
+                                ];
+                                let turn = Rotation::about_axis(m.spin.0, m.spin.1 * f);
+                                let ground =
+                                    Rotation::about_axis(m.earth_turn.0, m.earth_turn.1 * f);
+                                (
+                                    r,
+                                    in_view(o, r),
+                                    turn.then(&body_to_camera),
+                                    ground.then(&camera_to_earth),
+                                    Some(SequenceFrame {
+                                        id: sequences,
+                                        frame,
+                                    }),
+                                )
+                            }
+                        };
+                    plans.push(ImagePlan {
+                        index,
+                        scene: si,
+                        pose,
+                        mode: spec.mode,
+                        scale,
+                        thermal,
+                        range_m,
+                        offset_px,
+                        body_to_camera,
+                        sun_dir_camera,
+                        earth_dir_camera,
+                        earth_distance_m,
+                        earth_rendered: spec.earth,
+                        camera_to_earth,
+                        earth_day,
+                        noise_seed: spec.noise.then(|| {
+                            splitmix64(
+                                splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48),
+                            )
+                        }),
+                        gain_factor,
+                        netd_factor,
+                        bits,
+                        readout,
+                        moon,
+                        has_target: !empty,
+                        sequence,
+                    });
                 }
-                let index = plans.len();
-                plans.push(ImagePlan {
-                    index,
-                    scene: si,
-                    pose,
-                    mode: spec.mode,
-                    scale,
-                    thermal,
-                    range_m,
-                    offset_px,
-                    body_to_camera,
-                    sun_dir_camera: sun_body.map(|s| body_to_camera.apply(s)),
-                    earth_dir_camera,
-                    earth_distance_m,
-                    earth_rendered: spec.earth,
-                    camera_to_earth,
-                    earth_day,
-                    noise_seed: spec.noise.then(|| {
-                        splitmix64(splitmix64(seed ^ 0xA0A0) ^ (index as u64) ^ ((k as u64) << 48))
-                    }),
-                    gain_factor,
-                    netd_factor,
-                    bits,
-                    readout,
-                    moon,
-                    has_target: !empty,
-                });
+                // A sequence cut to nothing by the count takes no id.
+                if motion.is_some()
+                    && plans
+                        .last()
+                        .is_some_and(|p| p.sequence.is_some_and(|q| q.id == sequences))
+                {
+                    sequences += 1;
+                }
             }
         }
     }
@@ -420,6 +552,113 @@ count = 8
 illumination = ["sunlit", "eclipse"]
 range_m = 30.0
 "#;
+
+    const SEQUENCES: &str = r#"
+[dataset]
+seed = 11
+
+[[scene]]
+count = 12
+range_m = 40.0
+earth = false
+sequence = { frames = 5, range_end_m = 20.0, drift_px = 40.0, spin_deg = 60.0, earth_drift_deg = 4.0 }
+"#;
+
+    /// The angle of a rotation, rad.
+    fn angle(r: &Rotation) -> f64 {
+        let m = &r.0;
+        ((m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0)
+            .clamp(-1.0, 1.0)
+            .acos()
+    }
+
+    /// Sequences: `count` images in runs of `frames` (the last cut by the count), each
+    /// frame numbered in its sequence; within one, the pose's draws are shared and range,
+    /// place, the target's turn and the ground's move linearly to the drawn ends; each
+    /// frame has its own noise. A file without `sequence` plans no sequence.
+    #[test]
+    fn sequences_share_the_pose_and_move_linearly() {
+        let file = SceneFile::parse(SEQUENCES, "sequences.toml").unwrap();
+        let plans = plan(&file);
+        assert_eq!(plans.len(), 12);
+        let ids: Vec<(usize, usize)> = plans
+            .iter()
+            .map(|p| p.sequence.map(|q| (q.id, q.frame)).unwrap())
+            .collect();
+        let want: Vec<(usize, usize)> = (0..12).map(|i| (i / 5, i % 5)).collect();
+        assert_eq!(ids, want);
+        for run in plans.chunks(5) {
+            let first = &run[0];
+            for (k, p) in run.iter().enumerate() {
+                let f = k as f64 / 4.0;
+                assert_eq!(p.thermal, first.thermal);
+                assert_eq!(
+                    (p.pose, p.earth_day, p.bits, p.gain_factor, p.has_target),
+                    (
+                        first.pose,
+                        first.earth_day,
+                        first.bits,
+                        first.gain_factor,
+                        first.has_target
+                    )
+                );
+                assert_eq!(p.sun_dir_camera, first.sun_dir_camera);
+                assert_eq!(p.earth_dir_camera, first.earth_dir_camera);
+                assert!(
+                    (p.range_m - (40.0 - 20.0 * f)).abs() < 1e-9,
+                    "{}",
+                    p.range_m
+                );
+                let d = [
+                    p.offset_px[0] - first.offset_px[0],
+                    p.offset_px[1] - first.offset_px[1],
+                ];
+                assert!((d[0].hypot(d[1]) - 40.0 * f).abs() < 1e-9, "{d:?}");
+                let turn = p.body_to_camera.then(&first.body_to_camera.inverse());
+                assert!((angle(&turn) - 60f64.to_radians() * f).abs() < 1e-9);
+                // The sub-camera point moves along a great circle by the ground's turn.
+                let below =
+                    |q: &ImagePlan| q.camera_to_earth.apply(scale(q.earth_dir_camera, -1.0));
+                let cos = crate::world::geom::dot(below(p), below(first));
+                assert!((cos.clamp(-1.0, 1.0).acos() - 4f64.to_radians() * f).abs() < 1e-9);
+                if k > 0 {
+                    assert_ne!(p.noise_seed, run[k - 1].noise_seed);
+                }
+            }
+        }
+        let single = SceneFile::parse(
+            &SEQUENCES.replace(
+                "sequence = { frames = 5, range_end_m = 20.0, drift_px = 40.0, spin_deg = 60.0, earth_drift_deg = 4.0 }",
+                "",
+            ),
+            "single.toml",
+        )
+        .unwrap();
+        assert!(plan(&single).iter().all(|p| p.sequence.is_none()));
+        for (bad, field) in [
+            ("frames = 1", "sequence.frames"),
+            ("frames = 3, drift_px = -1.0", "sequence.drift_px"),
+            (
+                "frames = 3, earth_drift_deg = 200.0",
+                "sequence.earth_drift_deg",
+            ),
+            ("frames = 3, range_end_m = 0.1", "sequence.range_end_m"),
+        ] {
+            let text = SEQUENCES.replace(
+                "frames = 5, range_end_m = 20.0, drift_px = 40.0, spin_deg = 60.0, earth_drift_deg = 4.0",
+                bad,
+            );
+            let e = SceneFile::parse(&text, "bad.toml").unwrap_err().to_string();
+            assert!(e.contains(field), "{bad}: {e}");
+        }
+        let e = SceneFile::parse(
+            &SEQUENCES.replace("frames = 5,", "frames = 5, speed = 1.0,"),
+            "k.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("speed"), "{e}");
+    }
 
     /// Transient states sit on the orbit: eclipse states inside the shadow (no Sun),
     /// sunlit ones after it, their Sun and Earth directions the orbit's at their time;

@@ -464,6 +464,7 @@ mod tests {
             range_m: None,
             bits: None,
             signal_to_clutter: None,
+            sequence: None,
         }
     }
 

@@ -57,6 +57,10 @@ pub struct TruthRow {
     /// Signal-to-clutter ratio, when the file has a `signal_to_clutter` column and the
     /// frame a target.
     pub signal_to_clutter: Option<f64>,
+    /// The approach sequence the frame belongs to, when the file has a `sequence`
+    /// column (rendered sequences, [`crate::dataset::labels::SEQUENCE_COLUMNS`]):
+    /// [`Track::Sequence`] starts each sequence without a prior.
+    pub sequence: Option<u64>,
 }
 
 impl TruthRow {
@@ -301,6 +305,7 @@ pub fn read_truth_lines(
         let mut range_m = None;
         let mut bits = None;
         let mut signal_to_clutter = None;
+        let mut sequence = None;
         for (name, value) in header.iter().zip(&cols).skip(5) {
             if value.is_empty() {
                 continue;
@@ -320,6 +325,13 @@ pub fn read_truth_lines(
                             ))
                         })?,
                 );
+            } else if *name == "sequence" {
+                sequence = Some(value.parse::<u64>().map_err(|_| {
+                    EvalError(format!(
+                        "{}: sequence = `{value}`: expected a sequence number 0, 1, … (or empty outside a sequence)",
+                        at()
+                    ))
+                })?);
             } else if *name == "range_m" {
                 if let Ok(r) = value.parse::<f64>() {
                     groups.push(("range".into(), range_band(r).into()));
@@ -349,6 +361,7 @@ pub fn read_truth_lines(
                 range_m,
                 bits,
                 signal_to_clutter,
+                sequence,
             },
         ));
     }
@@ -532,8 +545,9 @@ pub enum Track {
     Jitter,
     /// The frames, in file-name order, are one sequence: each frame's prior is the
     /// tracker's (`auto`'s, `auto-v2`'s) own box on the previous frame (none on the
-    /// first frame and after a miss). Frames are scored one after the other on one
-    /// thread.
+    /// first frame and after a miss). With a `sequence` column (rendered approach
+    /// sequences) each sequence starts without a prior. Frames are scored one after the
+    /// other on one thread.
     Sequence,
 }
 
@@ -686,7 +700,13 @@ fn score_sequence(
     // Each tracker's box on the previous frame, by method.
     let mut previous: Vec<Option<(Roi, Option<Look>)>> = vec![None; options.methods.len()];
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
+    let mut last_sequence = None;
     for row in order {
+        // A new rendered sequence: no tracker carries a box into it.
+        if row.sequence != last_sequence {
+            previous.fill(None);
+            last_sequence = row.sequence;
+        }
         let path: PathBuf = images.join(&row.file);
         let frame = read_row_frame_with(images, row, options)?;
         let view = frame

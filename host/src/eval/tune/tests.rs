@@ -52,6 +52,7 @@ fn sets_scored_together_need_distinct_methods_and_keep_their_own_rules() {
             range_m: None,
             bits: None,
             signal_to_clutter: None,
+            sequence: None,
         });
     }
     // Sets of different rules scored together score as each alone.
@@ -105,6 +106,7 @@ fn where_parses_and_filters() {
         range_m: None,
         bits: None,
         signal_to_clutter: None,
+        sequence: None,
     };
     let rows = [
         row("a", &[("mode", "radiometry"), ("range", "close")]),

@@ -174,6 +174,67 @@ pub struct MoonSpec {
     pub probability: f64,
 }
 
+/// An approach sequence: each pose of the kind becomes `frames` consecutive images
+/// (per detection scale) of one encounter, the chaser closing in on the target while it
+/// drifts across the image, turns, and the Earth slides below. Every frame of a sequence
+/// shares the pose's target, material, illumination, thermal state, Earth day, gain,
+/// bit depth, readout and Moon; its own noise. Each quantity below is drawn once per
+/// sequence and reached linearly over it (frame `k` of `n` at `k / (n − 1)`). The
+/// temperatures stay the first frame's: a sequence spans seconds to minutes, far below
+/// a spacecraft's thermal time constants (hours), so a turning target keeps its
+/// temperature map while its faces turn (`docs/scenes.md` § Sequences).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SequenceSpec {
+    /// Frames per sequence, 2..=10 000.
+    pub frames: usize,
+    /// Camera–target distance at the last frame, m (0.5..=100 000); the first frame's is
+    /// the scene's `range_m`. Omitted: the range stays.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range_end_m: Option<Param>,
+    /// How far the target's centre moves across the image over the sequence, px
+    /// (0..=10 000), in a direction drawn per sequence (turned back on an axis where it
+    /// would leave the scene's `max_offset_fraction` of the frame). Default 0.
+    #[serde(default = "zero_param")]
+    pub drift_px: Param,
+    /// How far the target turns over the sequence, degrees (0..=3 600), about an axis
+    /// drawn per sequence. Default 0.
+    #[serde(default = "zero_param")]
+    pub spin_deg: Param,
+    /// How far the ground below moves over the sequence, degrees of the Earth's central
+    /// angle (0..=180; an orbit at 500 km covers about 0.064° per second), in a direction
+    /// drawn per sequence. Default 0.
+    #[serde(default = "zero_param")]
+    pub earth_drift_deg: Param,
+}
+
+fn zero_param() -> Param {
+    Param::Fixed(0.0)
+}
+
+/// Most frames in one sequence.
+pub const MAX_SEQUENCE_FRAMES: usize = 10_000;
+
+impl SequenceSpec {
+    pub(super) fn validate(&self, at: &str) -> Result<(), String> {
+        if !(2..=MAX_SEQUENCE_FRAMES).contains(&self.frames) {
+            return Err(format!(
+                "{at}.sequence.frames = {}: expected 2..={MAX_SEQUENCE_FRAMES} frames per sequence",
+                self.frames
+            ));
+        }
+        if let Some(r) = self.range_end_m {
+            r.validate(&format!("{at}.sequence.range_end_m"), 0.5, 1e5)?;
+        }
+        self.drift_px
+            .validate(&format!("{at}.sequence.drift_px"), 0.0, 1e4)?;
+        self.spin_deg
+            .validate(&format!("{at}.sequence.spin_deg"), 0.0, 3600.0)?;
+        self.earth_drift_deg
+            .validate(&format!("{at}.sequence.earth_drift_deg"), 0.0, 180.0)
+    }
+}
+
 /// One value, or a list that consecutive poses cycle through.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged, expecting = "not an accepted value")]

@@ -51,7 +51,10 @@ mod spec;
 mod tests;
 
 pub use camera::{Camera, RadiometryReadout, ResponseName, SignatureKind};
-pub use kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
+pub use kinds::{
+    Illumination, MAX_SEQUENCE_FRAMES, Mode, MoonSpec, OneOrMany, Param, SequenceSpec, TargetModel,
+    ThermalModel,
+};
 pub use spec::{
     DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, EarthTexture,
     MAX_OFFSET_FRACTION, SceneSpec,
@@ -99,7 +102,7 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// The built-in presets: name, description, TOML.
-pub const PRESETS: [(&str, &str, &str); 5] = [
+pub const PRESETS: [(&str, &str, &str); 6] = [
     (
         "paper",
         "Section 4.1: 12 000 cube+cylinder images, radiometry (3 material cases) and detection (Scales 1-3), close 15-50 m and far 340-440 m, sunlit and eclipse",
@@ -124,6 +127,11 @@ pub const PRESETS: [(&str, &str, &str); 5] = [
         "realistic-tango",
         "the Tango case study in the realistic world (1 000 radiometry images, close range, 10 % without a target)",
         include_str!("../../../presets/realistic-tango.toml"),
+    ),
+    (
+        "realistic-approach",
+        "approach sequences in the realistic world (2 448 images: 102 sequences of 24 frames, range closing, the target drifting and turning, the ground sliding; 10 % without a target): a tracker's test",
+        include_str!("../../../presets/realistic-approach.toml"),
     ),
 ];
 

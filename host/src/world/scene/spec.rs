@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::DetectionScale;
 
 use super::camera::{Camera, RadiometryReadout};
-use super::kinds::{Illumination, Mode, MoonSpec, OneOrMany, Param, TargetModel, ThermalModel};
+use super::kinds::{
+    Illumination, Mode, MoonSpec, OneOrMany, Param, SequenceSpec, TargetModel, ThermalModel,
+};
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
 use crate::world::spacecraft::MaterialCase;
@@ -261,6 +263,12 @@ pub struct SceneSpec {
     /// target-less frames only.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub no_target_fraction: f64,
+    /// Approach sequences ([`SequenceSpec`]): each pose becomes `frames` consecutive
+    /// images of one encounter (per scale: pose, then scale, then frame), labelled with
+    /// `sequence` and `frame` in `truth.csv` and `metadata.jsonl`. `count` still counts
+    /// images. Omitted: every image is its own pose (today's datasets, unchanged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<SequenceSpec>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -443,6 +451,9 @@ impl SceneSpec {
                     m.probability
                 ));
             }
+        }
+        if let Some(q) = &self.sequence {
+            q.validate(at)?;
         }
         if !(0.0..=1.0).contains(&self.no_target_fraction) {
             return Err(format!(
