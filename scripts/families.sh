@@ -15,6 +15,12 @@
 #              paperB paper, 300, seed 9001
 #              ts-fixtures, ts-dark, ts-real-earth: `tirroi testset --kind ...`, 200, seed 16
 #              (the real dark frame and the real Earth image; they never choose)
+#   approach sequences (`track`; `eval` and `compare` leave them out):
+#              famAS  realistic-approach, 960 frames (40 sequences), seed 7001 (family A)
+#              famASE scripts/training/realistic-approach-no-target.toml, 480, seed 7101
+#                     (family A, no target)
+#              famBS  realistic-approach, 960, seed 9001; famBSE the no-target file, 480,
+#                     seed 9101 (held out)
 #
 # Usage: scripts/families.sh render DIR          render every set into DIR (skips a set
 #                                                 whose folder exists; ~3 min on 2 cores)
@@ -22,6 +28,12 @@
 #                                                 both truth conventions: one row per set
 #                                                 and family A's summed mean IoU (½), then
 #                                                 each set's table rows (mode × range)
+#        scripts/families.sh track DIR [TIRROI]  tracking on the approach sequences (famAS,
+#                                                 famASE, famBS, famBSE): `auto-v2` with
+#                                                 --track off and sequence, mean IoU, false
+#                                                 alarms and median time against adaptive's
+#                                                 (all frames, and the frames it tracked:
+#                                                 those after one where it had a box)
 #        scripts/families.sh compare DIR A B     two binaries side by side (½ convention):
 #                                                 each set's mean IoU and false alarms under
 #                                                 A and B with the change, family A's and
@@ -35,7 +47,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 die() { echo "families: $*" >&2; exit 2; }
-[[ $# -ge 2 ]] || die "usage: scripts/families.sh render|eval DIR [TIRROI] | compare DIR A B"
+[[ $# -ge 2 ]] || die "usage: scripts/families.sh render|eval|track DIR [TIRROI] | compare DIR A B"
 cmd=$1
 dir=$2
 if [[ $cmd == compare ]]; then
@@ -119,6 +131,55 @@ case $cmd in
         for kind in fixtures dark real-earth; do
             render_set "ts-$kind" testset --kind "$kind" --count 200 --seed 16
         done
+        render_set famAS render --preset realistic-approach --count 960 --seed 7001
+        render_set famASE render --config "$training/realistic-approach-no-target.toml" \
+            --count 480 --seed 7101
+        render_set famBS render --preset realistic-approach --count 960 --seed 9001
+        render_set famBSE render --config "$training/realistic-approach-no-target.toml" \
+            --count 480 --seed 9101
+        ;;
+    track)
+        # The median core time (ms) of method $2 in eval's SUMMARY.csv $1.
+        median() { awk -F, -v m="$2" '$1 == m && $2 == "all" { print $9 }' "$1"; }
+        out="$(mktemp -d)"
+        trap 'rm -rf "$out"' EXIT
+        printf '| set | role | frames with a target | mean IoU ½ off → sequence | false alarms off → sequence | median ms off → sequence (adaptive) | tracked frames | their median / adaptive |\n'
+        printf '|---|---|---|---|---|---|---|---|\n'
+        for name in famAS famASE famBS famBSE; do
+            [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
+            role="held out"
+            [[ $name == famA* ]] && role="family A"
+            for mode in off sequence; do
+                "$tirroi" eval --images "$dir/$name" --method all --repeat 3 --track "$mode" \
+                    --out "$out/$name-$mode" >/dev/null
+                # `auto-v2`'s rows alone (`fields` reads a group's first row).
+                grep '^auto-v2,' "$out/$name-$mode/summary.csv" >"$out/$name-$mode/auto-v2.csv"
+            done
+            read -r targets iou_off fa_off empty _ <<<"$(fields "$out/$name-off/auto-v2.csv" all all)"
+            read -r _ iou_seq fa_seq _ <<<"$(fields "$out/$name-sequence/auto-v2.csv" all all)"
+            t_off=$(median "$out/$name-off/summary.csv" auto-v2)
+            t_seq=$(median "$out/$name-sequence/summary.csv" auto-v2)
+            t_ad=$(median "$out/$name-sequence/summary.csv" adaptive)
+            # The frames after one where auto-v2 had a box in the same sequence: their
+            # count and median time (µs in scores.csv) over adaptive's median.
+            times=$(awk -F, '
+                FNR == 1 { if (NR == 1) for (i = 1; i <= NF; i++) if ($i == "sequence") c = i; next }
+                NR == FNR { seq[$1] = $c; next }
+                $2 == "auto-v2" { print seq[$1], $1, ($3 != ""), $12 }' \
+                "$dir/$name/truth.csv" "$out/$name-sequence/scores.csv" | sort -k2,2 |
+                awk '{ if ($1 != last) had = 0; if (had) print $4 / 1000; had = $3; last = $1 }' |
+                sort -g)
+            read -r tracked ratio <<<"$(awk -v ad="$t_ad" 'NF { t[++k] = $1 }
+                END {
+                    if (!k) { print 0, "–"; exit }
+                    m = (k % 2) ? t[(k + 1) / 2] : (t[k / 2] + t[k / 2 + 1]) / 2
+                    printf "%d %.2f\n", k, m / ad
+                }' <<<"$times")"
+            [[ $targets -gt 0 ]] || { iou_off="–"; iou_seq="–"; }
+            printf '| %s | %s | %s | %s → %s | %s → %s | %.3f → %.3f (%.3f) | %s | %s |\n' "$name" "$role" \
+                "$targets" "$iou_off" "$iou_seq" "$(fa_text "$fa_off" "$empty")" \
+                "$(fa_text "$fa_seq" "$empty")" "$t_off" "$t_seq" "$t_ad" "$tracked" "$ratio"
+        done
         ;;
     eval)
         out="$(mktemp -d)"
@@ -198,5 +259,5 @@ case $cmd in
             done
         done
         ;;
-    *) die "unknown command $cmd (render, eval or compare)" ;;
+    *) die "unknown command $cmd (render, eval, track or compare)" ;;
 esac

@@ -1145,14 +1145,24 @@ impl AutoV2 {
         // `step_code`, which the refinement reads, are the window's still).
         let n8 = plane8.0 * plane8.1;
         let codes = work.labels4.as_mut().get_mut(..n8)?;
-        let (x0, y0) = (usize::from(p.x0), usize::from(p.y0));
-        let (x1, y1) = (usize::from(p.x1), usize::from(p.y1));
-        for (i, code) in codes.iter_mut().enumerate() {
-            let (cx, cy) = (i % plane8.0.max(1), i / plane8.0.max(1));
-            let (ca, cb) = (win.x0 + cx * cells::CELL_PX, win.y0 + cy * cells::CELL_PX);
-            let overlaps =
-                ca < x1 && ca + cells::CELL_PX > x0 && cb < y1 && cb + cells::CELL_PX > y0;
-            *code = if overlaps { u8::MAX } else { 0 };
+        codes.fill(0);
+        // The cells `[a, b)` along one axis that overlap the prior's pixels `[lo, hi)`
+        // (the window starts at `origin`, its plane has `count` cells).
+        let overlapped = |lo: u16, hi: u16, origin: usize, count: usize| {
+            let (lo, hi) = (usize::from(lo), usize::from(hi));
+            let a = lo.saturating_sub(origin) / cells::CELL_PX;
+            let b = hi
+                .saturating_sub(origin)
+                .div_ceil(cells::CELL_PX)
+                .min(count);
+            (a, b)
+        };
+        let (ax, bx) = overlapped(p.x0, p.x1, win.x0, plane8.0);
+        let (ay, by) = overlapped(p.y0, p.y1, win.y0, plane8.1);
+        for cy in ay..by {
+            if let Some(row) = codes.get_mut(cy * plane8.0 + ax..cy * plane8.0 + bx.max(ax)) {
+                row.fill(u8::MAX);
+            }
         }
         let winner = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
         refine(work, winner)
