@@ -160,21 +160,12 @@ case $cmd in
             t_off=$(median "$out/$name-off/summary.csv" auto-v2)
             t_seq=$(median "$out/$name-sequence/summary.csv" auto-v2)
             t_ad=$(median "$out/$name-sequence/summary.csv" adaptive)
-            # The frames after one where auto-v2 had a box in the same sequence: their
-            # count and median time (µs in scores.csv) over adaptive's median.
-            times=$(awk -F, '
-                FNR == 1 { if (NR == 1) for (i = 1; i <= NF; i++) if ($i == "sequence") c = i; next }
-                NR == FNR { seq[$1] = $c; next }
-                $2 == "auto-v2" { print seq[$1], $1, ($3 != ""), $12 }' \
-                "$dir/$name/truth.csv" "$out/$name-sequence/scores.csv" | sort -k2,2 |
-                awk '{ if ($1 != last) had = 0; if (had) print $4 / 1000; had = $3; last = $1 }' |
-                sort -g)
-            read -r tracked ratio <<<"$(awk -v ad="$t_ad" 'NF { t[++k] = $1 }
-                END {
-                    if (!k) { print 0, "–"; exit }
-                    m = (k % 2) ? t[(k + 1) / 2] : (t[k / 2] + t[k / 2 + 1]) / 2
-                    printf "%d %.2f\n", k, m / ad
-                }' <<<"$times")"
+            # The frames after one where auto-v2 had a box in the same sequence (eval's
+            # group `prior = yes`): their count and median time over adaptive's median.
+            read -r tracked ratio <<<"$(awk -F, -v ad="$t_ad" '
+                $1 == "auto-v2" && $2 == "prior" && $3 == "yes" { printf "%d %.2f\n", $4, $9 / ad }
+            ' "$out/$name-sequence/summary.csv")"
+            [[ -n $tracked ]] || { tracked=0; ratio="–"; }
             [[ $targets -gt 0 ]] || { iou_off="–"; iou_seq="–"; }
             printf '| %s | %s | %s | %s → %s | %s → %s | %.3f → %.3f (%.3f) | %s | %s |\n' "$name" "$role" \
                 "$targets" "$iou_off" "$iou_seq" "$(fa_text "$fa_off" "$empty")" \

@@ -842,7 +842,36 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
             } else {
                 assert!(on_strong > 0.9, "{method} new sequence: {b:?}");
             }
+            // Each tracker's frames are grouped by whether it came in with a box: the
+            // first frame of a sequence never does, the second of one does.
+            let (sh, summary) = csv(&out.join("summary.csv"));
+            let (m, g, v, n) = (
+                col(&sh, "method"),
+                col(&sh, "group"),
+                col(&sh, "value"),
+                col(&sh, "frames"),
+            );
+            let frames = |value: &str| {
+                summary
+                    .iter()
+                    .find(|r| r[m] == method && r[g] == "prior" && r[v] == value)
+                    .map_or(0, |r| r[n].parse::<usize>().unwrap())
+            };
+            let tracked = usize::from(carried);
+            assert_eq!(
+                (frames("yes"), frames("no")),
+                (tracked, 2 - tracked),
+                "{method}"
+            );
         }
+        // Methods that take no prior get no such group.
+        let (sh, summary) = csv(&out.join("summary.csv"));
+        let (m, g) = (col(&sh, "method"), col(&sh, "group"));
+        assert!(
+            summary
+                .iter()
+                .all(|r| r[g] != "prior" || r[m].starts_with("auto"))
+        );
     }
 }
 

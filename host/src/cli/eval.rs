@@ -66,7 +66,7 @@ pub struct EvalArgs {
     /// would hand it over); sequence (frames in file-name order, each frame's prior is
     /// the tracker's own box on the previous one; a `sequence` column in truth.csv, as
     /// `render --preset realistic-approach` writes, starts each sequence without one;
-    /// one thread).
+    /// the trackers' frames are grouped `prior = yes|no`; one thread).
     #[arg(long, default_value = "off", value_parser = parse_track)]
     pub track: scoring::Track,
     /// Which truth box scores: half (x0,y0,x1,y1: pixels covered at least the

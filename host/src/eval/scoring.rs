@@ -682,6 +682,14 @@ fn score_one(
     Ok((score, d.roi))
 }
 
+/// The methods that take a tracking prior ([`Track`]).
+pub const TRACKERS: [Method; 2] = [Method::Auto, Method::AutoV2];
+
+/// The group [`Track::Sequence`] gives each tracker's frames: `yes` when the tracker
+/// had a box on the frame before (in the same sequence), `no` when it came in without
+/// one and searched the whole frame.
+pub const PRIOR_GROUP: &str = "prior";
+
 /// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, each
 /// tracker's (`auto`, `auto-v2`) prior from its own box on the previous frame.
 fn score_sequence(
@@ -717,7 +725,13 @@ fn score_sequence(
             if m == Method::AutoV2 {
                 bank.set_look(prev.and_then(|(_, look)| look));
             }
-            let (score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
+            let (mut score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
+            if TRACKERS.contains(&m) {
+                // Whether the tracker came in with a box: a tracked frame, or one where
+                // it searched the whole frame (acquisition), each its own group.
+                let had = if prev.is_some() { "yes" } else { "no" };
+                score.groups.push((PRIOR_GROUP.into(), had.into()));
+            }
             // The tracker's box and its look on this frame, for the next.
             *prev = roi.map(|r| (r, Look::measure(&view, r)));
             scores.push(score);
