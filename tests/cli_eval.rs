@@ -754,6 +754,22 @@ fn multi_page_tiff_and_bits_below_the_data() {
     );
 }
 
+/// `tirroi eval --method all --track MODE` of the frames in `images` into `out`, which
+/// must succeed.
+fn eval_tracked(images: &Path, mode: &str, out: &Path) {
+    ok(&run(&[
+        "eval",
+        "--images",
+        s(images),
+        "--method",
+        "all",
+        "--track",
+        mode,
+        "--out",
+        s(out),
+    ]));
+}
+
 /// The stronger of [`blocks_frame`]'s two targets in the tracking tests, px.
 const STRONG_BLOCK: [u32; 4] = [60, 60, 120, 110];
 
@@ -808,17 +824,7 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
         )
         .unwrap();
         let out = dir.path().join(format!("eval-{carried}"));
-        ok(&run(&[
-            "eval",
-            "--images",
-            s(dir.path()),
-            "--method",
-            "all",
-            "--track",
-            "sequence",
-            "--out",
-            s(&out),
-        ]));
+        eval_tracked(dir.path(), "sequence", &out);
         let (h, rows) = csv(&out.join("scores.csv"));
         let (fc, mc, x0, y1) = (
             col(&h, "file"),
@@ -945,17 +951,7 @@ fn eval_track_hands_both_trackers_their_priors() {
     };
     for mode in ["jitter", "sequence"] {
         let out = dir.path().join(format!("eval-{mode}"));
-        ok(&run(&[
-            "eval",
-            "--images",
-            s(dir.path()),
-            "--method",
-            "all",
-            "--track",
-            mode,
-            "--out",
-            s(&out),
-        ]));
+        eval_tracked(dir.path(), mode, &out);
         let (h, rows) = csv(&out.join("scores.csv"));
         let (fc, mc) = (col(&h, "file"), col(&h, "method"));
         let (x0, y1) = (col(&h, "x0"), col(&h, "y1"));
