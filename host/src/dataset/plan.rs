@@ -626,6 +626,24 @@ sequence = { frames = 5, range_end_m = 20.0, drift_px = 40.0, spin_deg = 60.0, e
                 }
             }
         }
+        // Edge-cut targets drifting further than the frame is wide: every frame keeps
+        // its target in view (each offset is its own `keep_in_view`).
+        let far = SceneFile::parse(
+            &SEQUENCES
+                .replace("drift_px = 40.0", "drift_px = 400.0")
+                .replace("earth = false", "earth = false\nmax_offset_fraction = 1.5"),
+            "far.toml",
+        )
+        .unwrap();
+        let focal_px = far.camera.focal_px();
+        let half = [
+            far.camera.width as f64 / 2.0,
+            far.camera.height as f64 / 2.0,
+        ];
+        for p in plan(&far) {
+            let inner = TargetModel::CubeCylinder.inner_half_size_m() / p.range_m * focal_px;
+            assert_eq!(keep_in_view(p.offset_px, half, inner), p.offset_px, "{p:?}");
+        }
         let single = SceneFile::parse(
             &SEQUENCES.replace(
                 "sequence = { frames = 5, range_end_m = 20.0, drift_px = 40.0, spin_deg = 60.0, earth_drift_deg = 4.0 }",
