@@ -4,15 +4,17 @@
 accepted once it followed itself (`follows_prior`, the fast path's rule) on M
 consecutive frames with a confidence of at least F, and, with --ground, only when over
 those frames its centre moved against the ground's motion by at least D px per frame
-on the net. The ground's shift between consecutive frames is the peak of the phase
-correlation of the whole frames (high-passed by a 15-px box, Hann window), taken as zero
-where the peak is under --peak (deep space: the camera's own pattern stays put).
+on the net. The ground's shift between consecutive frames: `--ground fft`, the peak of
+the phase correlation of the whole frames (high-passed by a 15-px box, Hann window),
+taken as zero where the peak is under --peak (deep space: the camera's own pattern
+stays put); `--ground patches`, block matching of 16 patches (a flight-sized
+registration), taken as zero where fewer than --peak of them agree.
 
 Needs numpy, scipy and Pillow. Inputs: a set rendered with `sequence` (truth.csv with
 `sequence,frame`) and each frame's winner with the gate off:
 
     cargo run --release -p tirroi-host --example auto_v2_cells -- predict-all DIR W.csv
-    python3 scripts/sequence-confirmation.py DIR W.csv [--ground] [--peak 0.15]
+    python3 scripts/sequence-confirmation.py DIR W.csv [--ground fft|patches] [--peak P]
 
 Prints the gate alone's mean IoU and false alarms (frames without a target given a
 box), then the same for each M, D (with --ground) and F. A study, not the detector:
@@ -66,6 +68,39 @@ def ground_shift(a, b):
     return (ix if ix < w // 2 else ix - w), (iy if iy < h // 2 else iy - h), float(r.max())
 
 
+PATCH_GRID, PATCH_PX, SEARCH_PX = 4, 16, 12
+
+
+def patch_shift(a, b):
+    """The ground's shift by block matching, a flight-sized registration: in each cell of
+    a 4 x 4 grid the 16 x 16 patch of frame a with the most gradient (on a 4-px lattice),
+    found in frame b by the least sum of absolute differences (patch means removed) over
+    +-12 px; the median displacement, and the share of patches within 1 px of it (its
+    confidence)."""
+    h, w = a.shape
+    grad = np.abs(np.diff(a, axis=0))[:, :-1] + np.abs(np.diff(a, axis=1))[:-1, :]
+    moves = []
+    span = lambda n, k: (SEARCH_PX + k * (n - 2 * SEARCH_PX - PATCH_PX) // PATCH_GRID)
+    for gy in range(PATCH_GRID):
+        for gx in range(PATCH_GRID):
+            best = max(((grad[y:y + PATCH_PX, x:x + PATCH_PX].sum(), y, x)
+                        for y in range(span(h, gy), max(span(h, gy) + 1, span(h, gy + 1)), 4)
+                        for x in range(span(w, gx), max(span(w, gx) + 1, span(w, gx + 1)), 4)))
+            _, y, x = best
+            p = a[y:y + PATCH_PX, x:x + PATCH_PX]
+            p = p - p.mean()
+            cost = {}
+            for dy in range(-SEARCH_PX, SEARCH_PX + 1):
+                for dx in range(-SEARCH_PX, SEARCH_PX + 1):
+                    q = b[y + dy:y + dy + PATCH_PX, x + dx:x + dx + PATCH_PX]
+                    cost[(dx, dy)] = np.abs(p - (q - q.mean())).sum()
+            moves.append(min(cost, key=cost.get))
+    moves = np.array(moves)
+    m = np.median(moves, axis=0)
+    agree = float(np.mean(np.all(np.abs(moves - m) <= 1, axis=1)))
+    return int(m[0]), int(m[1]), agree
+
+
 def load(images, winners, ground, peak):
     truth = list(csv.DictReader(open(f"{images}/truth.csv")))
     if not truth or "sequence" not in truth[0]:
@@ -79,7 +114,7 @@ def load(images, winners, ground, peak):
         if ground:
             frame = np.asarray(Image.open(f"{images}/{t['file']}"), dtype=np.float64)
             if last is not None and t["sequence"] == last_seq:
-                dx, dy, p = ground_shift(last, frame)
+                dx, dy, p = (patch_shift if ground == "patches" else ground_shift)(last, frame)
                 if p >= peak:
                     g = (dx, dy)
             last, last_seq = frame, t["sequence"]
@@ -119,10 +154,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("images")
     ap.add_argument("winners")
-    ap.add_argument("--ground", action="store_true")
-    ap.add_argument("--peak", type=float, default=0.15)
+    ap.add_argument("--ground", choices=["fft", "patches"],
+                    help="take the ground's motion out: by phase correlation, or by block matching")
+    ap.add_argument("--peak", type=float, default=None,
+                    help="the registration's least confidence, else no motion (default: "
+                         "correlation peak 0.15 for fft, half the patches agreeing for patches)")
     a = ap.parse_args()
-    seqs = load(a.images, a.winners, a.ground, a.peak)
+    peak = a.peak if a.peak is not None else (0.5 if a.ground == "patches" else 0.15)
+    seqs = load(a.images, a.winners, a.ground, peak)
     print("gate alone: mean IoU %.4f, false alarms %d / %d" % score(seqs, 10**9, 0.55, 0))
     for m in (2, 3, 4):
         for d in ((0.5, 1.0, 1.5, 2.0) if a.ground else (0.0,)):
