@@ -17,7 +17,7 @@ pub const TRUTH_CSV_HEADER: &str = "file,x0,y0,x1,y1,mode,scale,target,material,
 /// `sequence`), after [`TRUTH_CSV_HEADER`]'s: the sequence (0, 1, …) and the frame in
 /// it, empty for an image outside one. `tirroi eval --track sequence` starts each
 /// sequence without a prior.
-pub const SEQUENCE_COLUMNS: &str = ",sequence,frame\n";
+pub const SEQUENCE_COLUMNS: &str = ",sequence,frame";
 
 /// Writes `truth.csv`, `coco.json` and `metadata.jsonl` (each atomically).
 pub(super) fn write_labels<'a>(
@@ -27,11 +27,11 @@ pub(super) fn write_labels<'a>(
 ) -> Result<(), DatasetError> {
     // Sequences add their two columns (every other dataset keeps its bytes).
     let sequences = file.scenes.iter().any(|s| s.sequence.is_some());
-    let mut csv = String::from(TRUTH_CSV_HEADER);
+    let mut csv = String::from(TRUTH_CSV_HEADER.trim_end());
     if sequences {
-        csv.pop();
         csv.push_str(SEQUENCE_COLUMNS);
     }
+    csv.push('\n');
     let mut jsonl = String::new();
     let mut images = Vec::new();
     let mut annotations = Vec::new();
@@ -46,7 +46,7 @@ pub(super) fn write_labels<'a>(
     for r in records {
         let [x0, y0, x1, y1] = r.bbox;
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{}",
             r.file,
             boxed(r.bbox),
             r.mode,
@@ -64,11 +64,11 @@ pub(super) fn write_labels<'a>(
             r.visible_share.map_or(String::new(), |s| format!("{s:.4}")),
         ));
         if sequences {
-            // Before the newline: `,sequence,frame` (empty outside a sequence).
-            csv.pop();
+            // `,sequence,frame`, empty outside a sequence.
             let opt = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
-            csv.push_str(&format!(",{},{}\n", opt(r.sequence), opt(r.frame)));
+            csv.push_str(&format!(",{},{}", opt(r.sequence), opt(r.frame)));
         }
+        csv.push('\n');
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');
         images.push(serde_json::json!({

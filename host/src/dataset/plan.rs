@@ -92,10 +92,28 @@ struct SequenceMotion {
     earth_turn: (Vec3, f64),
 }
 
+/// What moves over a sequence: range, m; the target centre's offset, px; body → camera;
+/// camera → Earth-fixed.
+type MovingPose = (f64, [f64; 2], Rotation, Rotation);
+
 impl SequenceMotion {
-    /// Share of the sequence behind frame `k`: 0 at the first frame, 1 at the last.
-    fn at(&self, k: usize) -> f64 {
-        k as f64 / (self.frames - 1).max(1) as f64
+    /// Frame `k`'s pose from the first frame's `first`: range and offset moved and the
+    /// target's and the ground's turns applied by `k / (frames − 1)` of the way (the
+    /// offset before any pull back into view).
+    fn pose_at(&self, k: usize, first: MovingPose) -> MovingPose {
+        let f = k as f64 / (self.frames - 1).max(1) as f64;
+        let (range_m, offset_px, body_to_camera, camera_to_earth) = first;
+        let turn = Rotation::about_axis(self.spin.0, self.spin.1 * f);
+        let ground = Rotation::about_axis(self.earth_turn.0, self.earth_turn.1 * f);
+        (
+            range_m + (self.range_end_m - range_m) * f,
+            [
+                offset_px[0] + self.drift_px[0] * f,
+                offset_px[1] + self.drift_px[1] * f,
+            ],
+            turn.then(&body_to_camera),
+            ground.then(&camera_to_earth),
+        )
     }
 }
 
@@ -127,7 +145,13 @@ fn sequence_motion(
     let side = random_direction(rng);
     let mut axis = crate::world::geom::cross(up_earth, side);
     if norm(axis) < 1e-9 {
-        axis = crate::world::geom::cross(up_earth, [1.0, 0.0, 0.0]);
+        // `side` along the sub-camera point: any axis perpendicular to it.
+        let helper = if up_earth[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        axis = crate::world::geom::cross(up_earth, helper);
     }
     let earth_turn = (
         normalize(axis),
@@ -460,40 +484,27 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
             };
             let sun_dir_camera = sun_body.map(|s| body_to_camera.apply(s));
             for (k, &scale) in scales.iter().enumerate() {
+                let sequence_start = plans.len();
                 for frame in 0..frames {
                     if plans.len() - kind_start == spec.count {
                         break;
                     }
                     let index = plans.len();
-                    // Frame `frame` of the sequence (the pose itself outside one): range,
-                    // place, the target's turn and the ground's reached linearly; the Sun
+                    // Frame `frame` of the sequence (the pose itself outside one); the Sun
                     // stays where it is in the camera frame (the target turns, not the
                     // chaser) and the temperatures stay the first frame's.
-                    let (range_m, offset_px, body_to_camera, camera_to_earth, sequence) =
-                        match motion {
-                            None => (range_m, offset_px, body_to_camera, camera_to_earth, None),
-                            Some(m) => {
-                                let f = m.at(frame);
-                                let r = range_m + (m.range_end_m - range_m) * f;
-                                let o = [
-                                    offset_px[0] + m.drift_px[0] * f,
-                                    offset_px[1] + m.drift_px[1] * f,
-                                ];
-                                let turn = Rotation::about_axis(m.spin.0, m.spin.1 * f);
-                                let ground =
-                                    Rotation::about_axis(m.earth_turn.0, m.earth_turn.1 * f);
-                                (
-                                    r,
-                                    in_view(o, r),
-                                    turn.then(&body_to_camera),
-                                    ground.then(&camera_to_earth),
-                                    Some(SequenceFrame {
-                                        id: sequences,
-                                        frame,
-                                    }),
-                                )
-                            }
-                        };
+                    let first = (range_m, offset_px, body_to_camera, camera_to_earth);
+                    let (range_m, offset_px, body_to_camera, camera_to_earth) = match motion {
+                        None => first,
+                        Some(m) => {
+                            let (r, o, body, ground) = m.pose_at(frame, first);
+                            (r, in_view(o, r), body, ground)
+                        }
+                    };
+                    let sequence = motion.map(|_| SequenceFrame {
+                        id: sequences,
+                        frame,
+                    });
                     plans.push(ImagePlan {
                         index,
                         scene: si,
@@ -525,11 +536,7 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
                     });
                 }
                 // A sequence cut to nothing by the count takes no id.
-                if motion.is_some()
-                    && plans
-                        .last()
-                        .is_some_and(|p| p.sequence.is_some_and(|q| q.id == sequences))
-                {
+                if motion.is_some() && plans.len() > sequence_start {
                     sequences += 1;
                 }
             }
