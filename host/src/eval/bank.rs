@@ -13,6 +13,10 @@ use tirroi_core::{BoxRule, DetectError, Detection, Frame, FrameCapacity, Method,
 use crate::dataset::{MANIFEST_FILE, Manifest};
 use crate::world::scene::SceneFile;
 
+/// The methods that take a tracking prior (the last frame's box): `auto` and `auto-v2`
+/// ([`DetectorBank::set_prior_of`]; `auto-v2` also a look, [`DetectorBank::set_look`]).
+pub const TRACKERS: [Method; 2] = [Method::Auto, Method::AutoV2];
+
 /// Every registered detector (the core's registry, [`Method::ALL`]) with its
 /// parameters and its scratch memory, ready to run frame after frame: the 328×248
 /// bank (boxed: about 190 KB) and, made on the first frame that needs them, the
@@ -87,11 +91,12 @@ impl DetectorBank {
         }
     }
 
-    /// Sets the tracking prior of both trackers, `auto` and `auto-v2` (the last
-    /// frame's box; `None`: search the whole frame).
+    /// Sets the tracking prior of both trackers ([`TRACKERS`]: the last frame's box;
+    /// `None`: search the whole frame).
     pub fn set_prior(&mut self, prior: Option<Roi>) {
-        self.set_prior_of(Method::Auto, prior);
-        self.set_prior_of(Method::AutoV2, prior);
+        for m in TRACKERS {
+            self.set_prior_of(m, prior);
+        }
     }
 
     /// Sets the tracking prior of `method` when it tracks (`auto`, `auto-v2`); the
@@ -315,10 +320,7 @@ mod tests {
             Params::AutoV2(AutoV2::default().with_prior(Some(prior)))
         );
         // The other methods keep their defaults.
-        for method in Method::ALL
-            .iter()
-            .filter(|m| !matches!(**m, Method::Auto | Method::AutoV2))
-        {
+        for method in Method::ALL.iter().filter(|m| !TRACKERS.contains(m)) {
             assert_eq!(bank.params(*method), method.default_params(), "{method}");
         }
         // A budgeted call runs the bank's `auto` (prior included): same answer as the

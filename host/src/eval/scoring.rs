@@ -35,7 +35,7 @@ use serde::Serialize;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::{BoxRule, Method, Roi};
 
-use crate::eval::bank::{DetectorBank, median};
+use crate::eval::bank::{DetectorBank, TRACKERS, median};
 use crate::eval::confidence::{self, Outcome};
 use crate::imaging::image_io::{ReadOptions, read_frame, read_frame_with};
 use crate::seed::{fnv1a64, stir};
@@ -681,9 +681,6 @@ fn score_one(
     };
     Ok((score, d.roi))
 }
-
-/// The methods that take a tracking prior ([`Track`]).
-pub const TRACKERS: [Method; 2] = [Method::Auto, Method::AutoV2];
 
 /// The group [`Track::Sequence`] gives each tracker's frames: `yes` when the tracker
 /// had a box on the frame before (in the same sequence), `no` when it came in without
