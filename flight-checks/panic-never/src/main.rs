@@ -27,6 +27,7 @@ use core::hint::black_box;
 use tirroi_core::frame::{DEFAULT_BIT_DEPTH, FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
 #[allow(unused_imports)]
 use tirroi_core::roi::auto::learned::look::Look;
+#[allow(unused_imports)]
 use tirroi_core::{Frame, Method, Roi};
 #[allow(unused_imports)]
 use tirroi_firmware::{Detectors, Workspace, synth};
