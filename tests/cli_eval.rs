@@ -832,6 +832,14 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
             col(&h, "x0"),
             col(&h, "y1"),
         );
+        // summary.csv: each tracker's frames grouped by whether it came in with a box.
+        let (sh, summary) = csv(&out.join("summary.csv"));
+        let (m, g, v, n) = (
+            col(&sh, "method"),
+            col(&sh, "group"),
+            col(&sh, "value"),
+            col(&sh, "frames"),
+        );
         for method in ["auto", "auto-v2"] {
             let boxed = |file: &str| {
                 let r = rows
@@ -848,15 +856,8 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
             } else {
                 assert!(on_strong > 0.9, "{method} new sequence: {b:?}");
             }
-            // Each tracker's frames are grouped by whether it came in with a box: the
-            // first frame of a sequence never does, the second of one does.
-            let (sh, summary) = csv(&out.join("summary.csv"));
-            let (m, g, v, n) = (
-                col(&sh, "method"),
-                col(&sh, "group"),
-                col(&sh, "value"),
-                col(&sh, "frames"),
-            );
+            // The first frame of a sequence never comes in with a box, the second of
+            // one does.
             let frames = |value: &str| {
                 summary
                     .iter()
@@ -871,8 +872,6 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
             );
         }
         // Methods that take no prior get no such group.
-        let (sh, summary) = csv(&out.join("summary.csv"));
-        let (m, g) = (col(&sh, "method"), col(&sh, "group"));
         assert!(
             summary
                 .iter()
