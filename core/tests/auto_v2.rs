@@ -5,7 +5,9 @@
 //! (`null` from one ‰ above it without a tracking prior, the same box at it); the same
 //! frame gives the same answer twice, with or without a prior (and the look of the last
 //! box, any or measured on the frame), in the same scratch and in a fresh one; a box of
-//! the fast tracking path only with a prior and a look; and through the registry
+//! the fast tracking path only with a prior and a look; a tracker's candidate only
+//! under the gate and at its floor, and the same answer with the floor off; and
+//! through the registry
 //! (`Method::AutoV2`) it answers as called directly. Parameters out of bounds are an
 //! error, never a panic.
 //!
@@ -58,8 +60,13 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
-        // (spot, link_cells, look): proptest's tuples end at 12.
-        (any::<bool>(), prop_oneof![Just(2u8), 1u8..=3], look()),
+        // (spot, link_cells, look, candidate floor): proptest's tuples end at 12.
+        (
+            any::<bool>(),
+            prop_oneof![Just(2u8), 1u8..=3],
+            look(),
+            prop_oneof![Just(None), (0u16..=1000).prop_map(Some)],
+        ),
     )
         .prop_map(
             |(
@@ -74,7 +81,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
-                (spot, link_cells, look),
+                (spot, link_cells, look, candidate_floor_permille),
             )| {
                 AutoV2 {
                     prior,
@@ -91,6 +98,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     candidates,
                     spot,
                     link_cells,
+                    candidate_floor_permille,
                 }
             },
         )
@@ -212,6 +220,7 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
     let d = det
         .detect(&f, &mut scratch)
         .expect("parameters within bounds");
+    let candidate = scratch.work().candidate();
     prop_assert!(d.score_permille <= SCORE_FULL_PERMILLE, "{d:?}");
     match d.roi {
         Some(r) => {
@@ -302,6 +311,23 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
         let feats = w.confidence_features();
         prop_assert!(feats.iter().all(|&v| v > -2000 && v <= 16_000), "{feats:?}");
     }
+    // A tracker's candidate under the gate: only with a floor, without a box, in
+    // [floor, gate), inside the frame; and the floor does not change the answer.
+    if let Some((r, score)) = candidate {
+        let floor = det.candidate_floor_permille;
+        prop_assert!(
+            d.roi.is_none() && floor.is_some_and(|f| score >= f),
+            "{d:?} {r:?} {score}"
+        );
+        prop_assert!(score < det.min_score_permille, "{r:?} {score}");
+        prop_assert!(!r.is_empty() && usize::from(r.x1) <= img.w && usize::from(r.y1) <= img.h);
+    }
+    let no_floor = AutoV2 {
+        candidate_floor_permille: None,
+        ..det
+    };
+    prop_assert_eq!(no_floor.detect(&f, &mut scratch).unwrap(), d);
+    prop_assert_eq!(scratch.work().candidate(), None);
     // Same answer twice: the same scratch, a fresh one, and through the registry.
     prop_assert_eq!(det.detect(&f, &mut scratch).unwrap(), d);
     prop_assert_eq!(det.detect(&f, &mut AutoV2Scratch::new()).unwrap(), d);
@@ -372,7 +398,7 @@ proptest! {
     /// Parameters out of bounds: an error naming the field, never a panic, on any frame.
     #[test]
     fn parameters_out_of_bounds_are_errors(
-        which in 0u8..8,
+        which in 0u8..9,
         seed in any::<u64>(),
     ) {
         let img = frame(seed, 64, 48, 14);
@@ -384,6 +410,7 @@ proptest! {
             4 => AutoV2 { candidates: 5, ..AutoV2::default() },
             5 => AutoV2 { link_cells: 0, ..AutoV2::default() },
             6 => AutoV2 { link_cells: 4, ..AutoV2::default() },
+            7 => AutoV2 { candidate_floor_permille: Some(1001), ..AutoV2::default() },
             _ => AutoV2 { saturated_erode_px: 9, ..AutoV2::default() },
         };
         let got = bad.detect(&img.frame(), &mut Box::new(AutoV2Scratch::new()));

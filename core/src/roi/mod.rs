@@ -22,6 +22,7 @@ mod components;
 mod mask;
 pub(crate) mod plane;
 pub mod registry;
+pub mod track;
 
 pub mod adaptive;
 pub mod auto;

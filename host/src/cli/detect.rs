@@ -12,8 +12,8 @@ use crate::eval::bank::DetectorBank;
 use crate::imaging::image_io::{ReadOptions, parse_box_px, parse_crop, read_frame_with};
 use tirroi_core::Method;
 use tirroi_core::roi::auto::learned::AutoV2;
-use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
+use tirroi_core::roi::track::Tracker;
 
 /// The options of `tirroi detect`.
 #[derive(Debug, clap::Args)]
@@ -67,9 +67,11 @@ pub struct DetectArgs {
     pub prior: Option<tirroi_core::Roi>,
     /// The files are a sequence, in the order given: each tracker's prior on a file is
     /// its own box on the file before (none after a miss; on the first file,
-    /// `--prior`), and `auto-v2` carries that box's look (its level against the
-    /// background on each side) to take its fast path: the last box's cells refined
-    /// without the classifier, kept when the new box looks the same.
+    /// `--prior`). `auto-v2` runs as the core's tracker: it carries that box's look
+    /// (its level against the background on each side) to take its fast path (the last
+    /// box's cells refined without the classifier, kept when the new box looks the
+    /// same), and without a box it acquires a target rated under the gate once that
+    /// moved against the ground over 3 frames (score 0.600).
     #[arg(long)]
     pub track: bool,
     /// Frames to process (PNG, TIFF or FITS).
@@ -141,9 +143,10 @@ pub fn run(args: &DetectArgs) -> ExitCode {
     let mut out = stdout.lock();
     // Each method's prior for the next file (used by the trackers only).
     let mut priors = vec![args.prior; methods.len()];
-    // `auto-v2`'s look of its last box on the file before (`--track`; none for
-    // `--prior`, which has no frame: there the window is searched).
-    let mut looks: Vec<Option<Look>> = vec![None; methods.len()];
+    // `--track`: `auto-v2`'s tracker (its last box and look, the ground, the run of
+    // candidates); `--prior` has no frame, so no look: there the window is searched.
+    let mut tracker = Tracker::new(AutoV2::default());
+    tracker.set_prior(args.prior);
     for path in files {
         let options = ReadOptions {
             bits,
@@ -171,12 +174,8 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                 continue;
             }
         };
-        for ((&method, prior), look) in methods.iter().zip(priors.iter_mut()).zip(looks.iter_mut())
-        {
+        for (&method, prior) in methods.iter().zip(priors.iter_mut()) {
             bank.set_prior_of(method, *prior);
-            if method == Method::AutoV2 {
-                bank.set_look(*look);
-            }
             let budget = args
                 .budget
                 .filter(|_| method == Method::Auto)
@@ -185,6 +184,9 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                 Some(b) => bank
                     .auto_within_timed(&view, b, repeat)
                     .map(|(d, report, t)| (d, t, Some(BudgetLine::new(b, &report)))),
+                None if args.track && method == Method::AutoV2 => bank
+                    .track_timed(&mut tracker, &view, repeat)
+                    .map(|(d, t)| (d, t, None)),
                 None => bank
                     .detect_timed(method, &view, repeat)
                     .map(|(d, t)| (d, t, None)),
@@ -198,7 +200,6 @@ pub fn run(args: &DetectArgs) -> ExitCode {
             };
             if args.track {
                 *prior = d.roi;
-                *look = d.roi.and_then(|r| Look::measure(&view, r));
             }
             let file = path.to_string_lossy();
             let written = if json {

@@ -32,8 +32,10 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use serde::Serialize;
+use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::learned::look::Look;
-use tirroi_core::{BoxRule, Method, Roi};
+use tirroi_core::roi::track::Tracker;
+use tirroi_core::{BoxRule, DetectError, Detection, Method, Roi};
 
 use crate::eval::bank::{DetectorBank, TRACKERS, median};
 use crate::eval::confidence::{self, Outcome};
@@ -665,9 +667,18 @@ fn score_one(
     path: &Path,
     repeat: usize,
 ) -> Result<(FrameScore, Option<Roi>), EvalError> {
-    let (d, time_us) = bank
-        .detect_timed(method, view, repeat)
-        .map_err(|e| EvalError(format!("{}: {method}: {e}", path.display())))?;
+    frame_score(bank.detect_timed(method, view, repeat), method, row, path)
+}
+
+/// A timed detection of `method` scored against the row's truth, and its box.
+fn frame_score(
+    timed: Result<(Detection, f64), DetectError>,
+    method: Method,
+    row: &TruthRow,
+    path: &Path,
+) -> Result<(FrameScore, Option<Roi>), EvalError> {
+    let (d, time_us) =
+        timed.map_err(|e| EvalError(format!("{}: {method}: {e}", path.display())))?;
     let score = FrameScore {
         file: row.file.clone(),
         method: method.name().to_string(),
@@ -688,7 +699,9 @@ fn score_one(
 pub const PRIOR_GROUP: &str = "prior";
 
 /// [`score`] for [`Track::Sequence`]: one bank, frames in file-name order, each
-/// tracker's (`auto`, `auto-v2`) prior from its own box on the previous frame.
+/// tracker's (`auto`, `auto-v2`) prior from its own box on the previous frame; `auto-v2`
+/// runs as the core's [`Tracker`] (its look, and targets acquired by their motion
+/// against the ground), `auto` with its last box.
 fn score_sequence(
     images: &Path,
     rows: &[TruthRow],
@@ -702,14 +715,16 @@ fn score_sequence(
     }
     let mut order: Vec<&TruthRow> = rows.iter().collect();
     order.sort_by(|a, b| a.file.cmp(&b.file));
-    // Each tracker's box on the previous frame, by method.
-    let mut previous: Vec<Option<(Roi, Option<Look>)>> = vec![None; options.methods.len()];
+    // `auto`'s box on the previous frame; `auto-v2`'s history is its tracker's.
+    let mut previous: Option<Roi> = None;
+    let mut tracker = Tracker::new(AutoV2::default());
     let mut scores = Vec::with_capacity(rows.len() * options.methods.len());
     let mut last_sequence = None;
     for row in order {
         // A new rendered sequence: no tracker carries a box into it.
         if row.sequence != last_sequence {
-            previous.fill(None);
+            previous = None;
+            tracker.reset();
             last_sequence = row.sequence;
         }
         let path: PathBuf = images.join(&row.file);
@@ -717,20 +732,27 @@ fn score_sequence(
         let view = frame
             .view()
             .map_err(|e| EvalError(format!("{}: {e}", path.display())))?;
-        for (&m, prev) in options.methods.iter().zip(previous.iter_mut()) {
-            bank.set_prior_of(m, prev.map(|(r, _)| r));
-            if m == Method::AutoV2 {
-                bank.set_look(prev.and_then(|(_, look)| look));
-            }
-            let (mut score, roi) = score_one(&mut bank, m, &view, row, &path, options.repeat)?;
-            if TRACKERS.contains(&m) {
+        for &m in &options.methods {
+            let had = TRACKERS.contains(&m).then(|| match m {
+                Method::AutoV2 => tracker.prior().is_some(),
+                _ => previous.is_some(),
+            });
+            let (mut score, roi) = if m == Method::AutoV2 {
+                let timed = bank.track_timed(&mut tracker, &view, options.repeat);
+                frame_score(timed, m, row, &path)?
+            } else {
+                bank.set_prior_of(m, previous);
+                score_one(&mut bank, m, &view, row, &path, options.repeat)?
+            };
+            if let Some(had) = had {
                 // Whether the tracker came in with a box: a tracked frame, or one where
                 // it searched the whole frame (acquisition), each its own group.
-                let had = if prev.is_some() { "yes" } else { "no" };
+                let had = if had { "yes" } else { "no" };
                 score.groups.push((PRIOR_GROUP.into(), had.into()));
             }
-            // The tracker's box and its look on this frame, for the next.
-            *prev = roi.map(|r| (r, Look::measure(&view, r)));
+            if m == Method::Auto {
+                previous = roi;
+            }
             scores.push(score);
         }
         progress();

@@ -157,6 +157,15 @@ pub struct AutoV2 {
     /// fixtures A, famAF, ½ convention) 1 → 2.472, **2 → 2.487**, 3 → 2.483, no
     /// false alarm added (`docs/detectors.md` § Session 37).
     pub link_cells: u8,
+    /// A tracker's candidate floor, ‰ of confidence, or `None` (the default: off). With
+    /// `Some(f)`, a region-stage winner rated below [`AutoV2::min_score_permille`] but
+    /// at least `f` is still refined by stages 4c–8 and kept as the frame's candidate
+    /// ([`AutoV2Work::candidate`]) before the call goes on (stage 5e; "no target" if
+    /// nothing else passes the gate): the evidence a tracker confirms over several
+    /// frames ([`crate::roi::track`]). The answer of the call does not change; the
+    /// refinement costs one more pass of stages 4c–8 on frames whose winner lies under
+    /// the gate. 0..=1000, else [`DetectError::InvalidParameter`].
+    pub candidate_floor_permille: Option<u16>,
 }
 
 /// Confidence of a box of stage 2c (deep space), ‰: its hit rate (IoU ≥ ½) on family
@@ -243,7 +252,7 @@ fn capped_window(
 /// Whether the fast path's box `r` follows the prior `p` (both cut to the frame): an
 /// IoU of [`TRACK_FAST_MIN_IOU_PERMILLE`] or more and every side within
 /// [`TRACK_FAST_SIDE_SLACK_PX`] + [`TRACK_FAST_SIDE_SLACK_PERMILLE`] of the prior's.
-fn follows_prior(p: &Roi, r: &Roi) -> bool {
+pub(crate) fn follows_prior(p: &Roi, r: &Roi) -> bool {
     let inter = u64::from(p.intersection(r).area());
     let union = u64::from(p.area()) + u64::from(r.area()) - inter;
     let slack = |size: u16| {
@@ -308,6 +317,7 @@ impl Default for AutoV2 {
             candidates: 3,
             spot: true,
             link_cells: 2,
+            candidate_floor_permille: None,
         }
     }
 }
@@ -461,6 +471,7 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     tracked: bool,
     deep_space: Option<smooth::DeepSpace>,
     spot: Option<(Roi, u16)>,
+    candidate: Option<(Roi, u16)>,
 }
 
 impl<C: FrameCapacity> AutoV2Work<C> {
@@ -533,6 +544,14 @@ impl<C: FrameCapacity> AutoV2Work<C> {
     pub fn spot(&self) -> Option<(Roi, u16)> {
         self.spot
     }
+
+    /// The last frame's candidate below the gate ([`AutoV2::candidate_floor_permille`]):
+    /// the region stage's winner refined, or else stage 5e's most confident spot,
+    /// with its confidence ‰, when that lies in `[floor, gate)`; `None` when the call
+    /// answered with a box, found nothing at the floor or the floor is off.
+    pub fn candidate(&self) -> Option<(Roi, u16)> {
+        self.candidate
+    }
 }
 
 impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
@@ -559,6 +578,7 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         tracked: false,
         deep_space: None,
         spot: None,
+        candidate: None,
     };
 }
 
@@ -1065,6 +1085,7 @@ impl AutoV2 {
     /// stands when it passes the gate, overlaps the prior and is not cut by the
     /// window's border inside the frame), else on the whole frame.
     fn run<C: FrameCapacity>(&self, frame: &Frame<'_>, work: &mut AutoV2Work<C>) -> Detection {
+        work.candidate = None;
         if let Some(d) = self.track_fast(frame, work) {
             return d;
         }
@@ -1181,11 +1202,26 @@ impl AutoV2 {
         let (plane8, lv) = prepare_cells(frame, work, win);
         work.tracked = false;
         work.spot = None;
+        work.candidate = None;
         let d = self.region_stages(frame, work, win, plane8, lv);
-        if d.roi.is_some() || !self.spot {
+        if d.roi.is_some() {
+            work.candidate = None;
             return d;
         }
-        self.spot_stage(frame, work, win, lv)
+        let d = if self.spot {
+            self.spot_stage(frame, work, win, lv)
+        } else {
+            d
+        };
+        if d.roi.is_some() {
+            work.candidate = None;
+        } else if work.candidate.is_none() {
+            // No region winner at the floor: stage 5e's best spot under the gate.
+            work.candidate = work
+                .spot
+                .filter(|&(_, s)| self.candidate_floor_permille.is_some_and(|f| s >= f));
+        }
+        d
     }
 
     /// Stage 5e ([`spot`]) after the other stages answered "no target": the most
@@ -1299,13 +1335,18 @@ impl AutoV2 {
         if let Some(d) = self.blob_over(frame, work, win, plane8, lv, blob_score, score_permille) {
             return d;
         }
-        if score_permille < self.min_score_permille {
+        let below_gate = score_permille < self.min_score_permille;
+        if below_gate
+            && self
+                .candidate_floor_permille
+                .is_none_or(|f| score_permille < f)
+        {
             return NO_TARGET;
         }
         // Stage 4c: the target cells near the winner's, at its body's level, join it.
         let (root, w8) = join_linked(work, plane8, n8, root, usize::from(self.link_cells), lv.p50)
             .unwrap_or((root, w8));
-        self.finish(
+        let d = self.finish(
             frame,
             work,
             win,
@@ -1314,7 +1355,13 @@ impl AutoV2 {
             (root, w8, next),
             score_permille,
             false,
-        )
+        );
+        if below_gate {
+            // A tracker's candidate: kept, and the call goes on as without a box.
+            work.candidate = d.roi.map(|r| (r, score_permille));
+            return NO_TARGET;
+        }
+        d
     }
 
     /// Stage 4b: of the [`AutoV2::candidates`] strongest components of `labels8`
@@ -1805,6 +1852,12 @@ impl Detector for AutoV2 {
             return Err(DetectError::InvalidParameter {
                 name: "min_score_permille",
                 expected: "0..=1000",
+            });
+        }
+        if self.candidate_floor_permille.is_some_and(|f| f > 1000) {
+            return Err(DetectError::InvalidParameter {
+                name: "candidate_floor_permille",
+                expected: "0..=1000 (‰ of confidence) or none",
             });
         }
         if self.saturated_erode_px > 8 {
