@@ -16,7 +16,7 @@
 #
 # Usage: scripts/panic-never.sh [--all-pending-fail] [COMPONENT...]
 #   with COMPONENTs: check only these, all required (e.g. `scripts/panic-never.sh auto`).
-#   components: otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior (cargo
+#   components: otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior tracker (cargo
 #   features of the check)
 # Needs: apt-get install rustc-web cargo-web rust-web-src lld binutils-arm-none-eabi
 #        (arm-none-eabi-objdump/addr2line, from gcc-arm-none-eabi) python3.
@@ -24,7 +24,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 
-REQUIRED=(otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior)
+REQUIRED=(otsu adaptive wge dog auto auto-prior sensor auto-v2 auto-v2-prior tracker)
 PENDING=()
 
 if [[ $# -gt 0 ]]; then

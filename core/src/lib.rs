@@ -11,7 +11,9 @@
 //! - [`frame`]: a validated, borrowed view of a DN frame ([`Frame`]).
 //! - [`roi`]: boxes ([`Roi`]), the shared [`Detector`] interface, the four detectors
 //!   of the paper: [`roi::otsu`], [`roi::adaptive`], [`roi::wge`], [`roi::dog`], and our
-//!   scene-aware [`roi::auto`] (with a tracking mode).
+//!   scene-aware [`roi::auto`] (with a tracking mode); [`roi::track`]: `auto-v2` over a
+//!   sequence of frames (its last box, and targets acquired by their motion against the
+//!   ground).
 //! - `link` (cargo feature `spi`, on by default): frame input over SPI, CRC-checked
 //!   rows read through an embedded-hal 1.0 `SpiDevice` by `link::FrameReader`, and a
 //!   `link::SimulatedCamera` serving a stored frame.
@@ -60,9 +62,12 @@
 //! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 352 | 16 KiB |
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 296 | 96 KiB |
 //! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 456 | 32 KiB |
-//! | auto-v2 | [`roi::auto::learned::AutoV2Scratch`] | [`roi::auto::learned::SCRATCH_BYTES`] = 48 760 | 48 KiB |
+//! | auto-v2 | [`roi::auto::learned::AutoV2Scratch`] | [`roi::auto::learned::SCRATCH_BYTES`] = 48 768 | 48 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
+//! A sequence tracker ([`roi::track::Tracker`]: `auto-v2` over consecutive frames)
+//! keeps its own state beside `auto-v2`'s scratch: [`roi::track::TRACKER_BYTES`] =
+//! 8 392 (budget 9 KiB).
 //!
 //! ## Frame capacity
 //!
@@ -80,7 +85,7 @@
 //! | WGE | 14 352 | 24 024 | 35 928 |
 //! | DoG | 74 296 | 275 640 | 644 984 |
 //! | auto | 25 456 | 66 448 | 136 208 |
-//! | auto-v2 | 48 760 | 159 344 | 358 512 |
+//! | auto-v2 | 48 768 | 159 360 | 358 528 |
 //!
 //! ## Memory of the camera model
 //!

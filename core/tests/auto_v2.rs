@@ -8,8 +8,9 @@
 //! the fast tracking path only with a prior and a look; a tracker's candidate only
 //! under the gate and at its floor, and the same answer with the floor off; and
 //! through the registry
-//! (`Method::AutoV2`) it answers as called directly. Parameters out of bounds are an
-//! error, never a panic.
+//! (`Method::AutoV2`) it answers as called directly; the sequence tracker
+//! (`roi::track::Tracker`) keeps the same invariants over three frames and answers the
+//! same after a reset. Parameters out of bounds are an error, never a panic.
 //!
 //! Runs are deterministic (a fixed seed) unless `PROPTEST_RNG_SEED` says otherwise.
 //! Debug builds run `auto-v2` at some 10–20 ms per full frame: the case counts keep
@@ -28,6 +29,7 @@ use tirroi_core::roi::auto::learned::{
     AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE,
     TRACKED_SCORE_PERMILLE,
 };
+use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
 use tirroi_core::{DetectError, Detector, Frame, Method, Roi, SCORE_FULL_PERMILLE};
 
@@ -452,4 +454,74 @@ fn registry_entry_is_auto_v2_with_its_defaults() {
         d.score_permille >= AutoV2::default().min_score_permille,
         "{d:?}"
     );
+}
+
+/// The core's sequence tracker (`roi::track::Tracker`) over `img` and two copies of it
+/// moved by `step` px along x per frame (the ground's registration and the candidate's
+/// run see motion): every step answers `Ok`; a box lies inside the frame with a
+/// confidence in range and at the gate, `null` scores 0; the tracker's prior is its
+/// last answer; the same sequence again after `reset` gives the same answers.
+fn check_tracker(img: &Img, det: AutoV2, step: usize) -> Result<(), TestCaseError> {
+    let frames: Vec<Vec<u16>> = (0..3)
+        .map(|k| {
+            (0..img.w * img.h)
+                .map(|i| {
+                    let (x, y) = (i % img.w, i / img.w);
+                    img.px[y * img.w + (x + k * step) % img.w]
+                })
+                .collect()
+        })
+        .collect();
+    let mut scratch = Box::new(AutoV2Scratch::new());
+    let mut tracker = Tracker::new(det);
+    let mut answers = Vec::new();
+    for px in &frames {
+        let f = Frame::new(px, img.w, img.h, img.bits).unwrap();
+        let d = tracker
+            .step(&f, &mut scratch)
+            .expect("parameters within bounds");
+        prop_assert!(d.score_permille <= SCORE_FULL_PERMILLE, "{d:?}");
+        match d.roi {
+            Some(r) => {
+                prop_assert!(!r.is_empty(), "{d:?}");
+                prop_assert!(
+                    usize::from(r.x1) <= img.w && usize::from(r.y1) <= img.h,
+                    "{d:?}"
+                );
+                prop_assert!(d.score_permille >= det.min_score_permille, "{d:?}");
+            }
+            None => prop_assert_eq!(d.score_permille, 0),
+        }
+        prop_assert_eq!(tracker.prior(), d.roi);
+        answers.push(d);
+    }
+    tracker.reset();
+    for (px, d) in frames.iter().zip(&answers) {
+        let f = Frame::new(px, img.w, img.h, img.bits).unwrap();
+        prop_assert_eq!(tracker.step(&f, &mut scratch).unwrap(), *d);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(24))]
+
+    /// The tracker on random frames of about the full size and on shaded skies.
+    #[test]
+    fn tracker_steps_keep_every_invariant(
+        w in 100usize..=FRAME_WIDTH,
+        h in 80usize..=FRAME_HEIGHT,
+        bits in prop_oneof![Just(14u8), 8u8..=16],
+        seed in any::<u64>(),
+        sky in any::<bool>(),
+        step in 0usize..6,
+        det in params(),
+    ) {
+        let img = if sky {
+            shaded_sky(&mut Rng::new(seed), w, h, bits)
+        } else {
+            frame(seed, w, h, bits)
+        };
+        check_tracker(&img, det, step)?;
+    }
 }

@@ -186,7 +186,7 @@ fn run(dir: &Path, target_names: &[String]) -> Result<Vec<String>, String> {
         .collect();
     // The columns of the instruction tables: every method, then the trackers tracking.
     let mut columns = methods.clone();
-    for tracking in ["auto+prior", "auto-v2+prior"] {
+    for tracking in ["auto+prior", "auto-v2+prior", "auto-v2+sequence"] {
         if host.iter().any(|l| field(l, "method") == tracking) {
             columns.push(tracking.to_string());
         }

@@ -9,6 +9,7 @@ use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::dog::{Dog, DogScratch};
 use tirroi_core::roi::otsu::{Otsu, OtsuScratch};
+use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::wge::{Wge, WgeScratch};
 use tirroi_core::roi::{Detector, Scratch};
 use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
@@ -42,7 +43,7 @@ pub enum SharedScratch {
     Dog(DogScratch),
     /// [`Auto`]'s scratch.
     Auto(AutoScratch),
-    /// [`AutoV2`]'s scratch (48 760 B on x86-64: below DoG's, so the area, and the
+    /// [`AutoV2`]'s scratch (48 768 B on x86-64: below DoG's, so the area, and the
     /// demo's RAM, keep DoG's size).
     AutoV2(AutoV2Scratch),
 }
@@ -111,10 +112,28 @@ fn auto_v2_in(
     run_in!(shared, AutoV2, params, frame)
 }
 
+/// `auto-v2`'s sequence tracker ([`Detectors::sequence_step`]): idle until its first
+/// step (tag 0 and nothing else, so the idle slot is zero bytes in `.bss`, as
+/// [`SharedScratch`]), then the tracker's state (8 KiB: the ground's patches).
+#[allow(clippy::large_enum_variant)] // one slot the size of the tracker, on purpose
+#[repr(u8)]
+pub enum TrackerSlot {
+    /// No step yet.
+    Idle,
+    /// The tracker after its last step.
+    Tracking(Tracker),
+}
+
+/// A fresh tracker with the default parameters, copied from flash on the first step
+/// (not built on the stack: an 8 KiB temporary there).
+const FRESH_TRACKER: TrackerSlot = TrackerSlot::Tracking(Tracker::new(AutoV2::DEFAULT));
+
 /// The detectors with their default parameters (what `tirroi detect` runs on the host,
-/// so the boxes can be compared bit for bit) and the one scratch area they share.
+/// so the boxes can be compared bit for bit), the one scratch area they share, and
+/// `auto-v2`'s sequence tracker.
 pub struct Detectors {
     shared: SharedScratch,
+    tracker: TrackerSlot,
 }
 
 impl Detectors {
@@ -123,12 +142,18 @@ impl Detectors {
     pub const fn new() -> Self {
         Detectors {
             shared: SharedScratch::Idle,
+            tracker: TrackerSlot::Idle,
         }
     }
 
     /// Bytes of the shared scratch area (the largest detector's scratch and the tag).
     pub const fn scratch_bytes() -> usize {
         core::mem::size_of::<SharedScratch>()
+    }
+
+    /// Bytes of the sequence tracker's slot ([`TrackerSlot`]: its state and the tag).
+    pub const fn tracker_bytes() -> usize {
+        core::mem::size_of::<TrackerSlot>()
     }
 
     /// Runs `method` with its default parameters on `frame`.
@@ -181,6 +206,33 @@ impl Detectors {
                 frame,
             ),
             _ => Err(NOT_A_TRACKER),
+        }
+    }
+
+    /// The next frame of the sequence for `auto-v2`'s tracker ([`Tracker::step`]:
+    /// `auto-v2` with the last box and look, the ground's registration and the
+    /// confirmation of a candidate under the gate; default parameters), in the shared
+    /// area switched to `auto-v2`'s scratch. The tracker's own state, [`TrackerSlot`]
+    /// ([`tirroi_core::roi::track::TRACKER_BYTES`]), is kept here between calls.
+    ///
+    /// Never inlined, for the same reason as [`Detectors::run`].
+    ///
+    /// # Errors
+    /// [`Tracker::step`]'s (never with the default parameters).
+    #[inline(never)]
+    pub fn sequence_step(&mut self, frame: &Frame<'_>) -> Result<Detection, DetectError> {
+        if !matches!(self.shared, SharedScratch::AutoV2(_)) {
+            // As `auto_v2_in`: from the constant, not a temporary on the stack.
+            self.shared = FRESH_AUTO_V2;
+        }
+        if matches!(self.tracker, TrackerSlot::Idle) {
+            self.tracker = FRESH_TRACKER;
+        }
+        match (&mut self.shared, &mut self.tracker) {
+            (SharedScratch::AutoV2(scratch), TrackerSlot::Tracking(tracker)) => {
+                tracker.step(frame, scratch)
+            }
+            _ => Err(NOT_SWITCHED),
         }
     }
 

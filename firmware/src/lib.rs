@@ -8,7 +8,9 @@
 //!    through the SPI frame link of the core ([`tirroi_core::link`]) from a simulated
 //!    camera into the one frame buffer, with one corrupted row to show a retry;
 //! 2. every detector of the core runs on it ([`detectors::Detectors`]), then the
-//!    trackers (`auto`, `auto-v2`) in tracking mode, each with its own box as the prior;
+//!    trackers (`auto`, `auto-v2`) in tracking mode, each with its own box as the prior,
+//!    and `auto-v2`'s sequence tracker steps on to it ([`tirroi_core::roi::track`]: the
+//!    frames taken as one sequence, so every step searches and registers the ground);
 //! 3. the camera model makes a frame on board ([`synth`]: band radiance table, DN map,
 //!    noise, row by row into the same buffer), and the detectors run on that too.
 //!
@@ -210,6 +212,22 @@ fn detect_all<M: Meter>(
         let reading = meter.stop();
         report_detection(emit, name, method, Some(prior), truth, result, reading);
     }
+    // The sequence tracker's step on this frame, the demo's frames taken as one
+    // sequence: unrelated frames, so the last box is refused and each step pays the
+    // search, the ground's registration and the candidate's refinement (a tracker
+    // acquiring, not one locked on).
+    meter.start();
+    let result = black_box(detectors.sequence_step(&frame));
+    let reading = meter.stop();
+    report_call(
+        emit,
+        name,
+        Method::AutoV2,
+        (None, true),
+        truth,
+        result,
+        reading,
+    );
 }
 
 /// Emits the event of one detector call; returns its box.
@@ -222,12 +240,27 @@ fn report_detection(
     result: Result<tirroi_core::Detection, tirroi_core::DetectError>,
     meter: MeterReading,
 ) -> Option<tirroi_core::Roi> {
+    report_call(emit, frame, method, (prior, false), truth, result, meter)
+}
+
+/// Emits the event of one call (`(prior, sequence)`: its tracking prior, and whether
+/// it was a step of the sequence tracker); returns its box.
+fn report_call(
+    emit: &mut dyn FnMut(&Event),
+    frame: &'static str,
+    method: Method,
+    (prior, sequence): (Option<tirroi_core::Roi>, bool),
+    truth: Option<tirroi_core::Roi>,
+    result: Result<tirroi_core::Detection, tirroi_core::DetectError>,
+    meter: MeterReading,
+) -> Option<tirroi_core::Roi> {
     match result {
         Ok(detection) => {
             emit(&Event::Detect {
                 frame,
                 method,
                 prior,
+                sequence,
                 roi: detection.roi,
                 foreground_px: detection.foreground_px,
                 iou: truth.map(|t| detection.roi.map_or(0.0, |r| r.iou(&t))),

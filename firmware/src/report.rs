@@ -14,6 +14,18 @@ pub struct MeterReading {
     pub stack_bytes: Option<u32>,
 }
 
+/// The suffix of a `detect` line's method: `+sequence` for a step of the sequence
+/// tracker, `+prior` for a tracking call, none for a whole-frame search.
+fn call_suffix(prior: &Option<Roi>, sequence: bool) -> &'static str {
+    if sequence {
+        "+sequence"
+    } else if prior.is_some() {
+        "+prior"
+    } else {
+        ""
+    }
+}
+
 /// One step of the demo.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Event {
@@ -51,6 +63,9 @@ pub enum Event {
         /// The tracking prior it was given (the trackers, `auto` and `auto-v2`, only),
         /// `None` for a full-frame search.
         prior: Option<Roi>,
+        /// A step of `auto-v2`'s sequence tracker (`roi::track::Tracker`, over the
+        /// demo's frames in order), not a single call.
+        sequence: bool,
         /// Its box, `None` when nothing was foreground.
         roi: Option<Roi>,
         /// Foreground pixels of its mask.
@@ -136,15 +151,14 @@ impl fmt::Display for Event {
                 frame,
                 method,
                 prior,
+                sequence,
                 roi,
                 foreground_px,
                 iou,
                 meter,
             } => {
                 write!(f, "detect frame={frame} method={method}")?;
-                if prior.is_some() {
-                    f.write_str("+prior")?;
-                }
+                f.write_str(call_suffix(&prior, sequence))?;
                 f.write_str(" box=")?;
                 match roi {
                     Some(r) => write!(f, "{},{},{},{}", r.x0, r.y0, r.x1, r.y1)?,
@@ -224,6 +238,7 @@ impl defmt::Format for Event {
                 frame,
                 method,
                 prior,
+                sequence,
                 roi,
                 foreground_px,
                 iou,
@@ -235,7 +250,7 @@ impl defmt::Format for Event {
                     "detect frame={=str} method={=str}{=str} box={=?} fg={=u32} iou={=?} {}",
                     frame,
                     method.name(),
-                    if prior.is_some() { "+prior" } else { "" },
+                    call_suffix(&prior, sequence),
                     b,
                     foreground_px,
                     iou,

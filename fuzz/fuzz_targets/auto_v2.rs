@@ -17,12 +17,18 @@
 //! grid points depart from any polynomial), the rest a small periodic pattern (their
 //! top 6 bits) on top; clipped to the bit depth. Byte 8's bit 5 turns stage 2c off,
 //! bit 4 stage 2d on. Byte 2's bits 4–5 are the components stage 4b rates − 1.
+//! Byte 3's bit 2 sets a tracker's candidate floor (half the gate): a candidate only
+//! without a box, in [floor, gate), and the same answer as without the floor. Byte 3's
+//! bit 3 also runs the frame as a three-frame sequence through the core's tracker
+//! (`roi::track::Tracker`; the DN moved by one pixel per frame): every step answers
+//! `Ok`, its box inside the frame with a confidence in range and at the gate.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch, BlobRule};
+use tirroi_core::roi::track::Tracker;
 use tirroi_core::{Detector, Frame, Roi, SCORE_FULL_PERMILLE};
 
 /// Control points of the smooth frames across and down.
@@ -93,6 +99,7 @@ fuzz_target!(|data: &[u8]| {
         spot: data[3] & 0x01 == 0,
         // 1..=3 (the width's byte's top bits: every value is also a width).
         link_cells: 1 + (data[0] >> 6) % 3,
+        candidate_floor_permille: None,
     };
     let dn: Vec<u16> = data[dn_from..]
         .chunks_exact(2)
@@ -113,8 +120,30 @@ fuzz_target!(|data: &[u8]| {
     } else {
         det
     };
+    let det = AutoV2 {
+        candidate_floor_permille: (data[3] & 0x04 != 0).then_some(det.min_score_permille / 2),
+        ..det
+    };
     let mut scratch = Box::new(AutoV2Scratch::new());
     let d = det.detect(&frame, &mut scratch).expect("valid parameters");
+    if let Some((r, score)) = scratch.work().candidate() {
+        let floor = det
+            .candidate_floor_permille
+            .expect("a candidate only with a floor");
+        assert!(
+            d.roi.is_none() && score >= floor && score < det.min_score_permille,
+            "{d:?} {score}"
+        );
+        assert!(
+            !r.is_empty() && usize::from(r.x1) <= w && usize::from(r.y1) <= h,
+            "{r:?}"
+        );
+    }
+    let no_floor = AutoV2 {
+        candidate_floor_permille: None,
+        ..det
+    };
+    assert_eq!(no_floor.detect(&frame, &mut scratch).unwrap(), d);
     assert!(d.score_permille <= SCORE_FULL_PERMILLE, "{d:?}");
     match d.roi {
         Some(r) => {
@@ -142,4 +171,23 @@ fuzz_target!(|data: &[u8]| {
     }
     // The same frame again in the same scratch gives the same detection.
     assert_eq!(det.detect(&frame, &mut scratch).unwrap(), d);
+    // The frame as a short sequence through the tracker (the DN moved by a pixel per
+    // frame: the ground's registration and the candidate's run see motion).
+    if data[3] & 0x08 != 0 {
+        let mut tracker = Tracker::new(det);
+        for k in 0..3 {
+            let moved: Vec<u16> = (0..w * h).map(|i| pixels[(i + k) % (w * h)]).collect();
+            let f = Frame::new(&moved, w, h, bits).expect("valid dimensions");
+            let t = tracker.step(&f, &mut scratch).expect("valid parameters");
+            assert!(t.score_permille <= SCORE_FULL_PERMILLE, "{t:?}");
+            match t.roi {
+                Some(r) => {
+                    assert!(!r.is_empty() && usize::from(r.x1) <= w && usize::from(r.y1) <= h);
+                    assert!(t.score_permille >= det.min_score_permille, "{t:?}");
+                }
+                None => assert_eq!(t.score_permille, 0, "{t:?}"),
+            }
+            assert_eq!(tracker.prior(), t.roi);
+        }
+    }
 });

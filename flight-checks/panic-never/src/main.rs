@@ -12,7 +12,8 @@
 //!
 //! Which components are linked is chosen by cargo features (`otsu`, `adaptive`, `wge`,
 //! `dog`, `auto`, `auto-prior`, `sensor`, `auto-v2`, the development detector, called
-//! from the core directly, and `auto-v2-prior`, it tracking through the firmware); `scripts/panic-never.sh` builds the required
+//! from the core directly, `auto-v2-prior`, it tracking through the firmware, and
+//! `tracker`, `auto-v2`'s sequence tracker through the firmware); `scripts/panic-never.sh` builds the required
 //! set, and on a failure or for components not yet required, each one alone, and names
 //! the functions and source lines that still reach a panic.
 //!
@@ -119,6 +120,20 @@ pub extern "C" fn _start() -> ! {
         if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, bits) {
             let detector = black_box(AutoV2::default());
             let _ = black_box(detector.detect(&frame, black_box(&mut scratch)));
+        }
+    }
+    #[cfg(feature = "tracker")]
+    {
+        // `auto-v2`'s sequence tracker through the firmware's call (`roi::track`): two
+        // opaque frames in a row, so the first step's capture, the second's registration
+        // against it and the confirmation are all linked.
+        let width = black_box(FRAME_WIDTH);
+        let height = black_box(FRAME_HEIGHT);
+        let bits = black_box(DEFAULT_BIT_DEPTH);
+        for _ in 0..black_box(2) {
+            if let Ok(frame) = Frame::new(black_box(&pixels[..]), width, height, bits) {
+                let _ = black_box(detectors.sequence_step(&frame));
+            }
         }
     }
     #[cfg(feature = "sensor")]

@@ -300,25 +300,31 @@ const CELL_RELABEL_CODES: u8 = 8;
 /// (a frame strewn with clipped pixels), pixels at the top DN per cell.
 const BLOB_RELABEL_PX: u8 = 8;
 
+impl AutoV2 {
+    /// The defaults (every field's documentation says why), as a constant: a tracker
+    /// or a flight `static` is built from it at compile time.
+    pub const DEFAULT: AutoV2 = AutoV2 {
+        prior: None,
+        look: None,
+        fine_sigma: 8,
+        cell_score: 0,
+        min_score_permille: 550,
+        saturated_erode_px: 2,
+        body: body::BodyParams::DEFAULT,
+        prescreen: true,
+        blob: BlobRule::Compete,
+        deep_space: true,
+        small_target: false,
+        candidates: 3,
+        spot: true,
+        link_cells: 2,
+        candidate_floor_permille: None,
+    };
+}
+
 impl Default for AutoV2 {
     fn default() -> Self {
-        AutoV2 {
-            prior: None,
-            look: None,
-            fine_sigma: 8,
-            cell_score: 0,
-            min_score_permille: 550,
-            saturated_erode_px: 2,
-            body: body::BodyParams::DEFAULT,
-            prescreen: true,
-            blob: BlobRule::Compete,
-            deep_space: true,
-            small_target: false,
-            candidates: 3,
-            spot: true,
-            link_cells: 2,
-            candidate_floor_permille: None,
-        }
+        AutoV2::DEFAULT
     }
 }
 
