@@ -17,9 +17,11 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tirroi_core::capacity::{Cap1024x768, FrameCapacity};
+use tirroi_core::roi::auto::learned::AutoV2;
+use tirroi_core::roi::track::Tracker as CoreTracker;
 use tirroi_core::sensor::noise::NoiseRms;
 use tirroi_core::sensor::{BandRadiance, DnMapping, NoiseField, NoiseLevel, expose_frame};
-use tirroi_core::{Frame, Method, Roi};
+use tirroi_core::{Detection, Frame, Method, Roi};
 use tirroi_host::dataset::{FrameRenderer, LabelledFrame};
 use tirroi_host::eval::bank::DetectorBank;
 use tirroi_host::world::scene::{self, Camera, ResponseName, SceneFile};
@@ -164,22 +166,9 @@ thread_local! {
     static BANK: RefCell<DetectorBank> = RefCell::new(DetectorBank::default());
 }
 
-/// Runs detector `method` on a 2-D uint16 frame of `bits`-bit DN; returns
-/// (box [x0, y0, x1, y1) or None, score 0–1, threshold, foreground px).
-#[pyfunction]
-#[pyo3(signature = (dn, method, bits))]
-fn detect(
-    dn: PyReadonlyArrayDyn<'_, u16>,
-    method: &str,
-    bits: u8,
-) -> PyResult<(Option<[u16; 4]>, f32, u32, u32)> {
-    let m = Method::from_name(method).ok_or_else(|| {
-        let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-        bad(format!(
-            "unknown method `{method}`; expected {}",
-            names.join(", ")
-        ))
-    })?;
+/// The row-major pixels of a 2-D uint16 frame of `bits`-bit DN, with its width and
+/// height, or the CLI's message (not 2-D, DN above the bit depth, a bad size).
+fn frame_pixels(dn: &PyReadonlyArrayDyn<'_, u16>, bits: u8) -> PyResult<(Vec<u16>, usize, usize)> {
     let shape = dn.shape().to_vec();
     let [height, width] = shape[..] else {
         return Err(bad(format!(
@@ -201,15 +190,79 @@ fn detect(
             16 - v.leading_zeros()
         )));
     }
-    let d = BANK
-        .with(|b| b.borrow_mut().detect(m, &frame))
-        .map_err(|e| bad(format!("{method}: {e}")))?;
-    Ok((
+    Ok((pixels, width, height))
+}
+
+/// A detection as the Python half takes it: (box [x0, y0, x1, y1) or None, score 0–1,
+/// threshold, foreground px).
+type DetectionTuple = (Option<[u16; 4]>, f32, u32, u32);
+
+fn detection_tuple(d: Detection) -> DetectionTuple {
+    (
         d.roi.map(|r: Roi| r.to_array()),
         d.score(),
         d.threshold,
         d.foreground_px,
-    ))
+    )
+}
+
+/// Runs detector `method` on a 2-D uint16 frame of `bits`-bit DN; returns
+/// (box [x0, y0, x1, y1) or None, score 0–1, threshold, foreground px).
+#[pyfunction]
+#[pyo3(signature = (dn, method, bits))]
+fn detect(dn: PyReadonlyArrayDyn<'_, u16>, method: &str, bits: u8) -> PyResult<DetectionTuple> {
+    let m = Method::from_name(method).ok_or_else(|| {
+        let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+        bad(format!(
+            "unknown method `{method}`; expected {}",
+            names.join(", ")
+        ))
+    })?;
+    let (pixels, width, height) = frame_pixels(&dn, bits)?;
+    let frame = Frame::new(&pixels, width, height, bits).map_err(bad)?;
+    let d = BANK
+        .with(|b| b.borrow_mut().detect(m, &frame))
+        .map_err(|e| bad(format!("{method}: {e}")))?;
+    Ok(detection_tuple(d))
+}
+
+/// `auto-v2` over a sequence of frames: the core's tracker (`tirroi detect --method
+/// auto-v2 --track`), its state kept between calls.
+#[pyclass(module = "tirroi._native")]
+struct Tracker {
+    inner: CoreTracker,
+}
+
+#[pymethods]
+impl Tracker {
+    /// A tracker without history, `auto-v2`'s default parameters.
+    #[new]
+    fn new() -> Self {
+        Tracker {
+            inner: CoreTracker::new(AutoV2::DEFAULT),
+        }
+    }
+
+    /// The next frame of the sequence (2-D uint16, `bits`-bit DN): as [`detect`].
+    fn step(&mut self, dn: PyReadonlyArrayDyn<'_, u16>, bits: u8) -> PyResult<DetectionTuple> {
+        let (pixels, width, height) = frame_pixels(&dn, bits)?;
+        let frame = Frame::new(&pixels, width, height, bits).map_err(bad)?;
+        let (d, _) = BANK
+            .with(|b| b.borrow_mut().track_timed(&mut self.inner, &frame, 1))
+            .map_err(|e| bad(format!("auto-v2: {e}")))?;
+        Ok(detection_tuple(d))
+    }
+
+    /// Forgets the history (a new sequence).
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+
+    /// The last frame's box [x0, y0, x1, y1) (the next frame's prior), or None.
+    #[getter]
+    fn prior(&self) -> Option<[u16; 4]> {
+        self.inner.prior().map(|r| r.to_array())
+    }
 }
 
 /// The core's band radiance of `response` (`tirroi sensor --response`), or the CLI's
@@ -423,6 +476,7 @@ fn camera_defaults() -> (f64, f64, f32, u8) {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Renderer>()?;
+    m.add_class::<Tracker>()?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(presets, m)?)?;
     m.add_function(wrap_pyfunction!(detect, m)?)?;

@@ -1,6 +1,6 @@
 """The Python package against the `tirroi` binary's own outputs: the same frames
 (DN, both truth boxes, metadata) as `tirroi render`, the same boxes and scores as
-`tirroi detect --json`, the same camera model as `tirroi sensor --json`, and the CLI's
+`tirroi detect --json` (and `--track` for the tracker), the same camera model as `tirroi sensor --json`, and the CLI's
 error messages.
 
 The binary is $TIRROI_BIN when set, else this checkout's release build, brought up
@@ -188,6 +188,37 @@ def test_detect_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> N
                 assert np.float32(got.score) == np.float32(line["score"]), (frame.file, line)
                 if got.box is None:
                     assert got.score == 0.0
+
+
+def test_tracker_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> None:
+    """`tirroi.Tracker` steps as `tirroi detect --method auto-v2 --track` over the same
+    files in the same order (frames of one bit depth: one sequence each), and forgets
+    its history on `reset`."""
+    for preset, count, seed in DATASETS:
+        d = cli_datasets[preset]
+        frames = list(tirroi.render(preset=preset, count=count, seed=seed))
+        by_bits: Dict[int, List[tirroi.Frame]] = {}
+        for f in frames:
+            by_bits.setdefault(f.bits, []).append(f)
+        for bits, group in by_bits.items():
+            files = [str(d / f.file) for f in group]
+            out = run(
+                tirroi_bin, "detect", "--json", "--method", "auto-v2", "--track",
+                "--bits", str(bits), *files,
+            ).stdout
+            lines = [json.loads(line) for line in out.splitlines()]
+            assert len(lines) == len(group)
+            tracker = tirroi.Tracker()
+            for frame, line in zip(group, lines):
+                got = tracker.step(frame.dn, bits=bits)
+                want_box = None if line["bbox"] is None else tuple(line["bbox"])
+                assert got.box == want_box, (frame.file, line)
+                assert np.float32(got.score) == np.float32(line["score"]), (frame.file, line)
+                assert tracker.prior == got.box
+            tracker.reset()
+            assert tracker.prior is None
+            first = tracker.step(group[0].dn, bits=bits)
+            assert first == tirroi.detect(group[0].dn, "auto-v2", bits=bits)
 
 
 def test_detect_takes_other_integer_arrays() -> None:

@@ -44,6 +44,20 @@ def detect(
 ) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int]:
     """(box (x0, y0, x1, y1) px or None, score 0..1, threshold, foreground px)."""
 
+class Tracker:
+    """``auto-v2`` over a sequence of frames (the core's tracker)."""
+
+    def __init__(self) -> None: ...
+    def step(
+        self, dn: npt.NDArray[np.uint16], bits: int
+    ) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int]:
+        """The next frame: (box or None, score 0..1, threshold, foreground px)."""
+    def reset(self) -> None:
+        """Forgets the history."""
+    @property
+    def prior(self) -> Optional[Tuple[int, int, int, int]]:
+        """The last frame's box, or None."""
+
 def band_radiance(
     temperature_k: npt.NDArray[np.float64],
     emissivity: npt.NDArray[np.float64],
