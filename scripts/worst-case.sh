@@ -81,7 +81,7 @@ awk -v slack="$max_slack" -v table="$out/table.md" -v passes_file="$out/otsu-pas
             if (pass_calls == 1 || p > max_passes) { max_passes = p; max_passes_at = v["case"] }
             pass_hist[p]++
         }
-        if (!(m in max) || x > max[m]) { max[m] = x; at[m] = v["case"] (("prior" in v) ? " prior " v["prior"] : "") (("look" in v) ? " look " v["look"] : "") }
+        if (!(m in max) || x > max[m]) { max[m] = x; at[m] = v["case"] (("prior" in v) ? " prior " v["prior"] : "") (("look" in v) ? " look " v["look"] : "") (("step" in v) ? " step " v["step"] : "") }
         if (!(m in seen)) { seen[m] = 1; extra[++k] = m }
     }
     END {

@@ -236,6 +236,17 @@ impl Detectors {
         }
     }
 
+    /// Hands `auto-v2`'s sequence tracker a last box and its look, as if the last
+    /// frame had given them (the worst-case run: a prior the next step refuses).
+    pub fn set_sequence_prior(&mut self, prior: Option<Roi>, look: Option<Look>) {
+        if matches!(self.tracker, TrackerSlot::Idle) {
+            self.tracker = FRESH_TRACKER;
+        }
+        if let TrackerSlot::Tracking(tracker) = &mut self.tracker {
+            tracker.set_prior(prior, look);
+        }
+    }
+
     /// Runs `auto` (tracking `prior` if given) within a work budget in Cortex-M7
     /// instructions ([`Auto::detect_within`]): its best box so far and where it stopped
     /// when the budget does not cover every stage.

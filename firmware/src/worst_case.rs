@@ -1,8 +1,8 @@
 //! Worst-case instruction counts on the emulated Cortex-M7 (issue 18, part 2; run by
 //! scripts/worst-case.sh): every detector of the core on every adversarial frame of
 //! [`tirroi_firmware::adversarial`], `auto` tracking each of its priors and `auto-v2`
-//! each of them and the largest windows it searches, one line per call over
-//! semihosting:
+//! each of them and the largest windows it searches, and `auto-v2`'s sequence tracker
+//! stepping through the cases as one sequence, one line per call over semihosting:
 //!
 //! ```text
 //! worst case=checker-7 method=otsu instructions=5712040 box=0,0,328,248 passes=1
@@ -164,6 +164,28 @@ mod target {
                             BoxOf(&result)
                         );
                     }
+                }
+            }
+            // `auto-v2`'s sequence tracker: this frame as the next of one sequence of all
+            // the cases (the ground registered against the last step's frame, the prior
+            // and look its last answer), then the same frame again (a still ground, its
+            // own box as the prior), then once per `auto-v2` prior with that prior's own
+            // look handed over (the fast path refines and may refuse, then the window,
+            // the frame, the registration and the candidate's refinement are paid).
+            if DEMO_METHODS.contains(&Method::AutoV2) {
+                let handed = AUTO_V2_PRIORS.iter().map(|&p| Some(p));
+                for prior in [None, None].into_iter().chain(handed) {
+                    if let Some(p) = prior {
+                        DETECTORS.set_sequence_prior(Some(p), Look::measure(&frame, p));
+                    }
+                    let (result, n) = count(overhead, || DETECTORS.sequence_step(&frame));
+                    failed |= result.is_err();
+                    calls += 1;
+                    hprintln!(
+                        "worst case={case} method=auto-v2+sequence prior={} instructions={n} box={}",
+                        PriorOf(prior),
+                        BoxOf(&result)
+                    );
                 }
             }
             // `auto` within a work budget: without a prior and with each prior, the

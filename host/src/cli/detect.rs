@@ -146,7 +146,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
     // `--track`: `auto-v2`'s tracker (its last box and look, the ground, the run of
     // candidates); `--prior` has no frame, so no look: there the window is searched.
     let mut tracker = Tracker::new(AutoV2::default());
-    tracker.set_prior(args.prior);
+    tracker.set_prior(args.prior, None);
     for path in files {
         let options = ReadOptions {
             bits,

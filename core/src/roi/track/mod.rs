@@ -218,11 +218,11 @@ impl Tracker {
         self.run = Confirmation::NONE;
     }
 
-    /// Sets the last frame's box without its look (a prior from elsewhere, e.g. a
-    /// previous run: the window around it is searched, the fast path needs a look);
-    /// `None` forgets it.
-    pub fn set_prior(&mut self, prior: Option<Roi>) {
-        self.last = prior.map(|r| (r, None));
+    /// Sets the last frame's box and its look on that frame (a prior from elsewhere,
+    /// e.g. a previous run: without a look the window around the box is searched, the
+    /// fast path needs one); `None` forgets it. The ground and the run are kept.
+    pub fn set_prior(&mut self, prior: Option<Roi>, look: Option<Look>) {
+        self.last = prior.map(|r| (r, look));
     }
 
     /// The last frame's box (the prior of the next frame), if any.
