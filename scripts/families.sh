@@ -21,6 +21,9 @@
 #                     (family A, no target)
 #              famBS  realistic-approach, 960, seed 9001; famBSE the no-target file, 480,
 #                     seed 9101 (held out)
+#              ts-real-earth-seq `tirroi testset --kind real-earth --sequence-frames 24`,
+#                     480 (20 sequences, half without a target), seed 16: the real
+#                     Earth image sliding under a fixed target (held out, never chooses)
 #
 # Usage: scripts/families.sh render DIR          render every set into DIR (skips a set
 #                                                 whose folder exists; ~3 min on 2 cores)
@@ -137,6 +140,8 @@ case $cmd in
         render_set famBS render --preset realistic-approach --count 960 --seed 9001
         render_set famBSE render --config "$training/realistic-approach-no-target.toml" \
             --count 480 --seed 9101
+        render_set ts-real-earth-seq testset --kind real-earth --sequence-frames 24 \
+            --count 480 --seed 16 --no-target-fraction 0.5
         ;;
     track)
         # The median core time (ms) of method $2 in eval's SUMMARY.csv $1.
@@ -145,7 +150,7 @@ case $cmd in
         trap 'rm -rf "$out"' EXIT
         printf '| set | role | frames with a target | mean IoU ½ off → sequence | false alarms off → sequence | median ms off → sequence (adaptive) | tracked frames | their median / adaptive |\n'
         printf '|---|---|---|---|---|---|---|---|\n'
-        for name in famAS famASE famBS famBSE; do
+        for name in famAS famASE famBS famBSE ts-real-earth-seq; do
             [[ -d $dir/$name ]] || die "no set $dir/$name (run: scripts/families.sh render $dir)"
             role="held out"
             [[ $name == famA* ]] && role="family A"

@@ -21,6 +21,7 @@ pub fn run(out: &Path, count: Option<usize>, seed: u64) -> Result<(), String> {
             reference: crate::dataset::testset::DEFAULT_REFERENCE_DIR.into(),
             no_target_fraction: None,
             preview: false,
+            sequence_frames: None,
         });
     }
     std::fs::create_dir_all(out).map_err(|e| format!("{}: cannot create: {e}", out.display()))?;

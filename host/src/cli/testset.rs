@@ -35,6 +35,12 @@ pub struct TestsetArgs {
     /// Also write preview/ (contrast-stretched RGB with the truth box in green).
     #[arg(long)]
     pub preview: bool,
+    /// real-earth only: frames per sequence (2..=100). The camera's window slides over
+    /// the real image by a fixed step per frame (up to 5 px per axis), the target stays
+    /// where it is in the frame; truth.csv gains `sequence,frame` (for `tirroi eval
+    /// --track sequence`), and --no-target-fraction counts sequences.
+    #[arg(long, value_name = "N")]
+    pub sequence_frames: Option<usize>,
 }
 
 /// Runs `tirroi testset`.
@@ -51,6 +57,7 @@ pub fn run(args: &TestsetArgs) -> Result<(), String> {
         no_target_fraction: args.no_target_fraction,
         preview: args.preview,
         progress: true,
+        sequence_frames: args.sequence_frames,
     };
     let s = testset::write_testset(&opts, &args.out).map_err(|e| e.to_string())?;
     println!(

@@ -249,6 +249,7 @@ mod tests {
             no_target_fraction: Some(0.75),
             preview: false,
             progress: false,
+            sequence_frames: None,
         };
         let bar = ProgressBar::hidden();
         let a = make_frames(&opts, &bar).expect("frames");

@@ -38,7 +38,7 @@ use tirroi_core::Roi;
 
 use super::DatasetError;
 use super::images::atomic_write;
-use super::labels::TRUTH_CSV_HEADER;
+use super::labels::{SEQUENCE_COLUMNS, TRUTH_CSV_HEADER};
 use crate::imaging::image_io::{FrameBuf, write_png16};
 use crate::imaging::overlay;
 use crate::progress;
@@ -128,6 +128,9 @@ pub struct TestsetOptions {
     pub preview: bool,
     /// Show a progress bar.
     pub progress: bool,
+    /// Frames per sequence (real-Earth only): the window slides over the real image
+    /// from frame to frame ([`real_earth::frames`]); `None`: independent frames.
+    pub sequence_frames: Option<usize>,
 }
 
 /// The labels and provenance of one test frame (a line of `metadata.jsonl`).
@@ -186,6 +189,12 @@ pub struct TestRecord {
     /// Real Earth: min and max brightness temperature of the window, K.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub window_bt_k: Option<[f64; 2]>,
+    /// The sequence the frame belongs to (`--sequence-frames`), 0, 1, …
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<usize>,
+    /// The frame's place in its sequence, 0, 1, …
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<usize>,
 }
 
 /// The procedural generator's parameters of a fixture frame.
@@ -284,13 +293,30 @@ pub fn make_frames(
             "--no-target-fraction {share}: expected 0..=1"
         )));
     }
-    let none = no_target_frames(opts.count, share, opts.seed);
+    let none = match opts.sequence_frames {
+        None => no_target_frames(opts.count, share, opts.seed),
+        Some(n) if opts.kind == Kind::RealEarth && (2..=MAX_SEQUENCE_FRAMES).contains(&n) => {
+            // The share counts sequences: a sequence is with or without a target.
+            let sequences = no_target_frames(opts.count.div_ceil(n), share, opts.seed);
+            (0..opts.count).map(|i| sequences[i / n]).collect()
+        }
+        Some(n) => {
+            return Err(DatasetError(format!(
+                "--sequence-frames {n}: expected 2..={MAX_SEQUENCE_FRAMES}, with --kind real-earth"
+            )));
+        }
+    };
     match opts.kind {
         Kind::Fixtures => Ok(fixtures::frames(opts.seed, &none, bar)),
         Kind::Dark => dark::frames(&opts.reference, opts.seed, &none, bar),
-        Kind::RealEarth => real_earth::frames(&opts.reference, opts.seed, &none, bar),
+        Kind::RealEarth => {
+            real_earth::frames(&opts.reference, opts.seed, &none, opts.sequence_frames, bar)
+        }
     }
 }
+
+/// Most frames per real-Earth sequence (`--sequence-frames`).
+pub const MAX_SEQUENCE_FRAMES: usize = 100;
 
 /// The frame file name of index `i`.
 pub fn file_name(i: usize) -> String {
@@ -346,7 +372,13 @@ pub fn write_testset(opts: &TestsetOptions, dir: &Path) -> Result<TestsetSummary
 /// # Errors
 /// A serialisation error (not expected).
 pub fn labels(frames: &[TestFrame]) -> Result<(String, String), DatasetError> {
-    let mut csv = String::from(TRUTH_CSV_HEADER);
+    // Sequences add the renderer's two columns (other sets keep their bytes).
+    let sequences = frames.iter().any(|f| f.record.sequence.is_some());
+    let mut csv = String::from(TRUTH_CSV_HEADER.trim_end());
+    if sequences {
+        csv.push_str(SEQUENCE_COLUMNS);
+    }
+    csv.push('\n');
     let mut jsonl = String::new();
     let boxed = |b: [u16; 4]| {
         if Roi::new(b[0], b[1], b[2], b[3]).is_empty() {
@@ -361,7 +393,7 @@ pub fn labels(frames: &[TestFrame]) -> Result<(String, String), DatasetError> {
         // earth_fraction, noise_seed, bits, quarter box, signal_to_clutter and
         // visible_share (not computed for test frames: empty).
         csv.push_str(&format!(
-            "{},{},{},,{},{},{},{},{:.4},{},{},{},,\n",
+            "{},{},{},,{},{},{},{},{:.4},{},{},{},,",
             r.file,
             boxed(r.bbox),
             r.mode.as_deref().unwrap_or(""),
@@ -374,6 +406,11 @@ pub fn labels(frames: &[TestFrame]) -> Result<(String, String), DatasetError> {
             r.bits,
             boxed(r.bbox_quarter),
         ));
+        if sequences {
+            let field = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
+            csv.push_str(&format!(",{},{}", field(r.sequence), field(r.frame)));
+        }
+        csv.push('\n');
         jsonl.push_str(&serde_json::to_string(r).map_err(|e| DatasetError(e.to_string()))?);
         jsonl.push('\n');
     }
@@ -427,6 +464,7 @@ mod tests {
             no_target_fraction: None,
             preview: false,
             progress: false,
+            sequence_frames: None,
         };
         let s = write_testset(&opts, &dir.join("a")).expect("a");
         write_testset(&opts, &dir.join("b")).expect("b");
@@ -466,6 +504,7 @@ mod tests {
             no_target_fraction: None,
             preview: false,
             progress: false,
+            sequence_frames: None,
         };
         let e = make_frames(&opts, &ProgressBar::hidden()).unwrap_err().0;
         assert!(

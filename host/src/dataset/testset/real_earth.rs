@@ -11,6 +11,7 @@
 //! range of Eq. 17 or the fixed gain ([`READOUT_FIXED_SHARE`]), a bit depth of
 //! [`BITS`], and noise at the camera's NETD.
 
+use std::collections::HashSet;
 use std::path::Path;
 
 use indicatif::ProgressBar;
@@ -146,7 +147,74 @@ impl RealEarth {
     }
 }
 
-/// The frames of the real-Earth set (`none[i]`: frame i without a target).
+/// Largest slide of the real ground per frame and axis, px: the renderer's approach
+/// sequences slide their ground by up to about 5 px per frame; at least 1 px on one
+/// axis, so every sequence moves.
+pub const SEQUENCE_MAX_SLIDE_PX: isize = 5;
+
+/// Salt of a sequence's seed.
+const SEQUENCE_SALT: u64 = 0xEA27_5E00_0000_0043;
+
+/// A sequence's path over the real image: the first window's corner, the slide per
+/// frame (px, x and y in the source), and the readout shared by its frames.
+struct SequencePath {
+    corner: (usize, usize),
+    slide: (isize, isize),
+    flip: u8,
+    fixed: bool,
+    bits: u8,
+}
+
+/// The path of sequence `s` (`frames` frames): a slide drawn in ±[`SEQUENCE_MAX_SLIDE_PX`]
+/// and a first corner whose every window along it lies inside the data.
+///
+/// # Errors
+/// No such corner in 10 000 draws (an image with too little data for the slide).
+fn sequence_path(
+    earth: &RealEarth,
+    valid: &HashSet<(usize, usize)>,
+    seed: u64,
+    s: usize,
+    frames: usize,
+) -> Result<SequencePath, DatasetError> {
+    let mut rng = Pcg64::seed_from_u64(splitmix64(seed ^ SEQUENCE_SALT ^ s as u64));
+    let m = SEQUENCE_MAX_SLIDE_PX;
+    let mut slide = (0, 0);
+    while slide == (0, 0) {
+        slide = (rng.gen_range(-m..=m), rng.gen_range(-m..=m));
+    }
+    let flip: u8 = rng.gen_range(0..4);
+    let fixed = rng.gen_bool(READOUT_FIXED_SHARE);
+    let bits = BITS[rng.gen_range(0..BITS.len())];
+    for _ in 0..10_000 {
+        let corner = earth.corners[rng.gen_range(0..earth.corners.len())];
+        let inside = (0..frames).all(|k| {
+            let x = corner.0.checked_add_signed(slide.0 * k as isize);
+            let y = corner.1.checked_add_signed(slide.1 * k as isize);
+            x.zip(y).is_some_and(|c| valid.contains(&c))
+        });
+        if inside {
+            return Ok(SequencePath {
+                corner,
+                slide,
+                flip,
+                fixed,
+                bits,
+            });
+        }
+    }
+    Err(DatasetError(format!(
+        "real-earth sequence {s}: no path of {frames} windows sliding {slide:?} px per frame \
+         lies inside the image's data"
+    )))
+}
+
+/// The frames of the real-Earth set (`none[i]`: frame i without a target). With
+/// `sequence_frames` = n, frames come in sequences of n (frame i is frame i mod n of
+/// sequence i / n): the camera's window slides over the real image by a fixed step
+/// per frame (the ground moving, [`SEQUENCE_MAX_SLIDE_PX`]), the target composited
+/// where it is in every frame (the camera following it), readout shared, noise per
+/// frame; `none` of a sequence's first frame holds for all of it.
 ///
 /// # Errors
 /// [`DatasetError`] for missing reference data or a frame the renderer refuses.
@@ -154,32 +222,51 @@ pub fn frames(
     reference: &Path,
     seed: u64,
     none: &[bool],
+    sequence_frames: Option<usize>,
     bar: &ProgressBar,
 ) -> Result<Vec<TestFrame>, DatasetError> {
-    let with_target = none.iter().filter(|&&n| !n).count();
+    // A sequence's frames share one target (the first frame's `none` decides).
+    let per = sequence_frames.unwrap_or(1).max(1);
+    let leads: Vec<bool> = none.iter().step_by(per).copied().collect();
+    let with_target = leads.iter().filter(|&&n| !n).count();
     let targets = TargetRenders::new(with_target, seed)?;
     let camera0 = targets.scene_file().camera;
     let lib = targets.library();
     let earth = RealEarth::load(reference, (camera0.width, camera0.height), &lib.band)?;
     let cal = Calibration::hayabusa2_tir().map_err(DatasetError)?;
-    let mut rank = vec![None; none.len()];
+    let mut rank = vec![None; leads.len()];
     let mut k = 0;
-    for (i, &n) in none.iter().enumerate() {
+    for (i, &n) in leads.iter().enumerate() {
         if !n {
             rank[i] = Some(k);
             k += 1;
         }
     }
+    let valid: HashSet<(usize, usize)> = earth.corners.iter().copied().collect();
     none.par_iter()
         .enumerate()
         .map(|(i, _)| {
             let mut rng = Pcg64::seed_from_u64(splitmix64(seed ^ EARTH_SALT ^ i as u64));
-            let corner = earth.corners[rng.gen_range(0..earth.corners.len())];
-            let flip: u8 = rng.gen_range(0..4);
-            let fixed = rng.gen_bool(READOUT_FIXED_SHARE);
-            let bits = BITS[rng.gen_range(0..BITS.len())];
+            let (s, frame) = (i / per, i % per);
+            let (corner, flip, fixed, bits, place) = match sequence_frames {
+                None => {
+                    let corner = earth.corners[rng.gen_range(0..earth.corners.len())];
+                    let flip: u8 = rng.gen_range(0..4);
+                    let fixed = rng.gen_bool(READOUT_FIXED_SHARE);
+                    let bits = BITS[rng.gen_range(0..BITS.len())];
+                    (corner, flip, fixed, bits, None)
+                }
+                Some(_) => {
+                    let q = sequence_path(&earth, &valid, seed, s, per)?;
+                    let at = (
+                        q.corner.0.wrapping_add_signed(q.slide.0 * frame as isize),
+                        q.corner.1.wrapping_add_signed(q.slide.1 * frame as isize),
+                    );
+                    (at, q.flip, q.fixed, q.bits, Some((s, frame)))
+                }
+            };
             let noise_seed = Some(rng.r#gen::<u64>());
-            let target: Option<TargetRender> = match rank[i] {
+            let target: Option<TargetRender> = match rank[s] {
                 Some(k) => Some(targets.render(k)?),
                 None => None,
             };
@@ -237,6 +324,8 @@ pub fn frames(
                 mask_px: on_target,
                 window: Some([corner.0, corner.1, usize::from(flip)]),
                 window_bt_k: Some([f64::from(lo) / TB_SCALE, f64::from(hi) / TB_SCALE]),
+                sequence: place.map(|(s, _)| s),
+                frame: place.map(|(_, k)| k),
                 ..TestRecord::default()
             };
             bar.inc(1);
@@ -298,6 +387,73 @@ mod tests {
         }
     }
 
+    /// `--sequence-frames`: frames come in sequences whose window slides by one fixed
+    /// step per frame (at most `SEQUENCE_MAX_SLIDE_PX` per axis, never none) inside the
+    /// data, with one readout and one target each; `truth.csv` gains `sequence,frame`;
+    /// the share without a target counts sequences; other kinds and lengths are refused.
+    #[test]
+    fn sequences_slide_the_real_ground() {
+        let Some(r) = reference() else { return };
+        let opts = TestsetOptions {
+            kind: Kind::RealEarth,
+            count: 12,
+            seed: 5,
+            reference: r,
+            no_target_fraction: Some(0.4),
+            preview: false,
+            progress: false,
+            sequence_frames: Some(4),
+        };
+        let bar = ProgressBar::hidden();
+        let frames = make_frames(&opts, &bar).expect("frames");
+        for (a, b) in frames
+            .iter()
+            .zip(&make_frames(&opts, &bar).expect("frames"))
+        {
+            assert_eq!((&a.frame, &a.record), (&b.frame, &b.record), "seeded");
+        }
+        let mut without = 0;
+        for seq in frames.chunks(4) {
+            let first = &seq[0].record;
+            let [x0, y0, flip] = first.window.expect("a window");
+            let [x1, y1, _] = seq[1].record.window.expect("a window");
+            let step = (x1 as isize - x0 as isize, y1 as isize - y0 as isize);
+            assert_ne!(step, (0, 0));
+            assert!(step.0.abs() <= SEQUENCE_MAX_SLIDE_PX && step.1.abs() <= SEQUENCE_MAX_SLIDE_PX);
+            without += usize::from(first.target == "none");
+            for (k, f) in seq.iter().enumerate() {
+                let rec = &f.record;
+                assert_eq!((rec.sequence, rec.frame), (Some(first.index / 4), Some(k)));
+                let w = rec.window.expect("a window");
+                let at = (
+                    x0 as isize + step.0 * k as isize,
+                    y0 as isize + step.1 * k as isize,
+                );
+                assert_eq!((w[0] as isize, w[1] as isize, w[2]), (at.0, at.1, flip));
+                assert_eq!((rec.bits, &rec.readout), (first.bits, &first.readout));
+                assert_eq!((&rec.target, rec.bbox), (&first.target, first.bbox));
+            }
+        }
+        // 40 % of three sequences, rounded up: two without a target.
+        assert_eq!(without, 2);
+        let (csv, _) = crate::dataset::testset::labels(&frames).expect("labels");
+        let header = csv.lines().next().unwrap_or_default();
+        assert!(header.ends_with(",sequence,frame"), "{header}");
+        assert!(
+            csv.lines().nth(6).unwrap_or_default().ends_with(",1,1"),
+            "{csv}"
+        );
+        for (kind, n) in [(Kind::Dark, Some(4)), (Kind::RealEarth, Some(1))] {
+            let bad = TestsetOptions {
+                kind,
+                sequence_frames: n,
+                ..opts.clone()
+            };
+            let e = make_frames(&bad, &bar).expect_err("refused");
+            assert!(e.to_string().contains("--sequence-frames"), "{e}");
+        }
+    }
+
     #[test]
     fn frames_are_seeded_physical_and_labelled() {
         let Some(r) = reference() else { return };
@@ -309,6 +465,7 @@ mod tests {
             no_target_fraction: Some(0.5),
             preview: false,
             progress: false,
+            sequence_frames: None,
         };
         let bar = ProgressBar::hidden();
         let a = make_frames(&opts, &bar).expect("frames");
