@@ -251,8 +251,9 @@ impl Tracker {
         self.confirm.validate()?;
         let d = detector.detect(frame, scratch)?;
         if let (Some(r), Some(_)) = (d.roi, detector.prior) {
-            // The track held: no evidence to gather, and no registration paid on a
-            // tracked frame; a run restarts from this box without a ground.
+            // A box with a prior (the track held, or the search found one): no evidence
+            // to gather, and no registration paid on a tracked frame; a run restarts
+            // from this box without a ground.
             self.ground.clear();
             self.run.restart(r);
             self.last = Some((r, Look::measure(frame, r)));
