@@ -161,16 +161,21 @@ def test_scene_file_gives_the_same_frames(tmp_path: Path, tirroi_bin: Path) -> N
         assert a.truth == b.truth and a.metadata == b.metadata
 
 
+def frames_by_bits(preset: str, count: int, seed: int) -> Dict[int, List[tirroi.Frame]]:
+    """The frames of a preset, grouped by bit depth (one `tirroi detect --bits` call
+    each), in file order."""
+    by_bits: Dict[int, List[tirroi.Frame]] = {}
+    for f in tirroi.render(preset=preset, count=count, seed=seed):
+        by_bits.setdefault(f.bits, []).append(f)
+    return by_bits
+
+
 def test_detect_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> None:
     methods = tirroi.methods()
     assert "auto" in methods and len(set(methods)) == len(methods)
     for preset, count, seed in DATASETS:
         d = cli_datasets[preset]
-        frames = list(tirroi.render(preset=preset, count=count, seed=seed))
-        by_bits: Dict[int, List[tirroi.Frame]] = {}
-        for f in frames:
-            by_bits.setdefault(f.bits, []).append(f)
-        for bits, group in by_bits.items():
+        for bits, group in frames_by_bits(preset, count, seed).items():
             files = [str(d / f.file) for f in group]
             out = run(tirroi_bin, "detect", "--json", "--method", "all", "--bits", str(bits), *files).stdout
             lines = [json.loads(line) for line in out.splitlines()]
@@ -196,11 +201,7 @@ def test_tracker_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> 
     its history on `reset`."""
     for preset, count, seed in DATASETS:
         d = cli_datasets[preset]
-        frames = list(tirroi.render(preset=preset, count=count, seed=seed))
-        by_bits: Dict[int, List[tirroi.Frame]] = {}
-        for f in frames:
-            by_bits.setdefault(f.bits, []).append(f)
-        for bits, group in by_bits.items():
+        for bits, group in frames_by_bits(preset, count, seed).items():
             files = [str(d / f.file) for f in group]
             out = run(
                 tirroi_bin, "detect", "--json", "--method", "auto-v2", "--track",
