@@ -13,7 +13,7 @@
 //! agreement and so no shift.
 //!
 //! Cost per frame at 328×248: the gradient of the frame once (2 absolute differences
-//! per pixel) and, per patch, 169 half-resolution positions of 64 differences plus 9
+//! per pixel, on every other row) and, per patch, 169 half-resolution positions of 64 differences plus 9
 //! full-resolution ones of 256: about 0.25 M differences in all, against 2.6 M for
 //! the exhaustive full-resolution search it replaces (`scripts/sequence-confirmation.py
 //! --ground patches`). Memory: the patches, [`PATCHES_BYTES`].
@@ -29,8 +29,8 @@ pub const GRID: usize = 4;
 pub const PATCH_PX: usize = 16;
 
 /// Largest shift searched per axis, px per frame (the approach sequences of the
-/// renderer move the ground by up to ~6 px per frame; twice that for margin). The
-/// patches are kept this far from the frame's borders.
+/// renderer slide the ground by up to about 5 px per frame; more than twice that for
+/// margin). The patches are kept this far from the frame's borders.
 pub const SEARCH_PX: usize = 12;
 
 /// Step of the lattice on which patch corners are chosen, px (the gradient is summed
