@@ -94,13 +94,9 @@ macro_rules! run_in {
     }};
 }
 
-/// Runs `auto-v2` with `params` in the shared area, switched to a fresh `auto-v2`
-/// scratch first when another detector used it last.
-fn auto_v2_in(
-    shared: &mut SharedScratch,
-    params: AutoV2,
-    frame: &Frame<'_>,
-) -> Result<Detection, DetectError> {
+/// `auto-v2`'s scratch in the shared area, switched to a fresh `auto-v2` scratch first
+/// when another detector used it last (`None` never: it just switched).
+fn auto_v2_scratch(shared: &mut SharedScratch) -> Option<&mut AutoV2Scratch> {
     if !matches!(shared, SharedScratch::AutoV2(_)) {
         // From a constant (copied from flash), not built on the stack and moved as
         // `scratch_in!` does: LLVM turns the other detectors' fresh scratch into a
@@ -109,7 +105,22 @@ fn auto_v2_in(
         // The constant is the whole area, 74 KB of flash, for 33 KB of RAM (peak 9.5 KB).
         *shared = FRESH_AUTO_V2;
     }
-    run_in!(shared, AutoV2, params, frame)
+    match shared {
+        SharedScratch::AutoV2(scratch) => Some(scratch),
+        _ => None,
+    }
+}
+
+/// Runs `auto-v2` with `params` in the shared area ([`auto_v2_scratch`]).
+fn auto_v2_in(
+    shared: &mut SharedScratch,
+    params: AutoV2,
+    frame: &Frame<'_>,
+) -> Result<Detection, DetectError> {
+    match auto_v2_scratch(shared) {
+        Some(scratch) => Detector::detect(&params, frame, scratch),
+        None => Err(NOT_SWITCHED),
+    }
 }
 
 /// `auto-v2`'s sequence tracker ([`Detectors::sequence_step`]): idle until its first
@@ -127,6 +138,19 @@ pub enum TrackerSlot {
 /// A fresh tracker with the default parameters, copied from flash on the first step
 /// (not built on the stack: an 8 KiB temporary there).
 const FRESH_TRACKER: TrackerSlot = TrackerSlot::Tracking(Tracker::new(AutoV2::DEFAULT));
+
+impl TrackerSlot {
+    /// The tracker, made fresh on first use (`None` never: it just did).
+    fn tracker(&mut self) -> Option<&mut Tracker> {
+        if matches!(self, TrackerSlot::Idle) {
+            *self = FRESH_TRACKER;
+        }
+        match self {
+            TrackerSlot::Tracking(tracker) => Some(tracker),
+            TrackerSlot::Idle => None,
+        }
+    }
+}
 
 /// The detectors with their default parameters (what `tirroi detect` runs on the host,
 /// so the boxes can be compared bit for bit), the one scratch area they share, and
@@ -221,17 +245,8 @@ impl Detectors {
     /// [`Tracker::step`]'s (never with the default parameters).
     #[inline(never)]
     pub fn sequence_step(&mut self, frame: &Frame<'_>) -> Result<Detection, DetectError> {
-        if !matches!(self.shared, SharedScratch::AutoV2(_)) {
-            // As `auto_v2_in`: from the constant, not a temporary on the stack.
-            self.shared = FRESH_AUTO_V2;
-        }
-        if matches!(self.tracker, TrackerSlot::Idle) {
-            self.tracker = FRESH_TRACKER;
-        }
-        match (&mut self.shared, &mut self.tracker) {
-            (SharedScratch::AutoV2(scratch), TrackerSlot::Tracking(tracker)) => {
-                tracker.step(frame, scratch)
-            }
+        match (auto_v2_scratch(&mut self.shared), self.tracker.tracker()) {
+            (Some(scratch), Some(tracker)) => tracker.step(frame, scratch),
             _ => Err(NOT_SWITCHED),
         }
     }
@@ -239,10 +254,7 @@ impl Detectors {
     /// Hands `auto-v2`'s sequence tracker a last box and its look, as if the last
     /// frame had given them (the worst-case run: a prior the next step refuses).
     pub fn set_sequence_prior(&mut self, prior: Option<Roi>, look: Option<Look>) {
-        if matches!(self.tracker, TrackerSlot::Idle) {
-            self.tracker = FRESH_TRACKER;
-        }
-        if let TrackerSlot::Tracking(tracker) = &mut self.tracker {
+        if let Some(tracker) = self.tracker.tracker() {
             tracker.set_prior(prior, look);
         }
     }

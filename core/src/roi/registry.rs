@@ -209,6 +209,16 @@ macro_rules! detector_registry {
         }
 
         impl<C: $crate::capacity::FrameCapacity> $Bank<C> {
+            $(
+                /// This detector's scratch in the bank, for a caller that runs it itself
+                /// (e.g. a sequence tracker holding its own state across frames).
+                pub fn $field(
+                    &mut self,
+                ) -> &mut $crate::roi::Scratch<<$Det as $crate::roi::Detector>::Work<C>, C> {
+                    &mut self.$field
+                }
+            )+
+
             /// Fresh scratch for every detector at capacity `C` (a `const fn`).
             pub const fn for_capacity() -> Self {
                 $Bank {

@@ -4,8 +4,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
+use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::learned::look::Look;
-use tirroi_core::roi::auto::learned::{AutoV2, AutoV2Scratch};
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
@@ -34,16 +34,6 @@ pub struct DetectorBank {
     scratch_1024x768: Option<Box<Detectors<Cap1024x768>>>,
     /// `auto`'s scratch for budgeted calls (328×248), made on the first one.
     auto_budgeted: Option<Box<AutoScratch>>,
-    /// `auto-v2`'s scratch for [`Tracker`] calls, by capacity, made on the first one.
-    tracker_scratch: TrackerScratch,
-}
-
-/// `auto-v2`'s scratch for [`Tracker::step`] at each capacity, made on first use.
-#[derive(Default)]
-struct TrackerScratch {
-    reference: Option<Box<AutoV2Scratch>>,
-    cap_640x512: Option<Box<AutoV2Scratch<Cap640x512>>>,
-    cap_1024x768: Option<Box<AutoV2Scratch<Cap1024x768>>>,
 }
 
 /// A fresh bank of capacity `C` on the heap. Never inlined, and called only when a
@@ -55,14 +45,6 @@ struct TrackerScratch {
 #[cold]
 fn new_bank<C: FrameCapacity>() -> Box<Detectors<C>> {
     Box::new(Detectors::for_capacity())
-}
-
-/// A fresh `auto-v2` scratch of capacity `C` on the heap (made outside any stack
-/// frame that also holds a bank: [`new_bank`]).
-#[inline(never)]
-#[cold]
-fn fresh_scratch<C: FrameCapacity>() -> Box<AutoV2Scratch<C>> {
-    Box::new(AutoV2Scratch::for_capacity())
 }
 
 /// True when `frame` fits capacity `C`.
@@ -80,7 +62,6 @@ impl Default for DetectorBank {
             scratch_640x512: None,
             scratch_1024x768: None,
             auto_budgeted: None,
-            tracker_scratch: TrackerScratch::default(),
         }
     }
 }
@@ -193,11 +174,12 @@ impl DetectorBank {
     }
 
     /// The next frame of `tracker`'s sequence ([`Tracker::step`]) with this bank's
-    /// `auto-v2` parameters (the prior, look and candidate floor are the tracker's),
-    /// `repeat` times (at least once) from the same tracker state: the detection, the
-    /// median wall time of the step alone in microseconds; the tracker is left as after
-    /// one step. A repeated step starts from a copy of the state (8 KiB: well under a
-    /// microsecond, inside the timed call).
+    /// `auto-v2` parameters (the prior, look and candidate floor are the tracker's) in
+    /// the bank's `auto-v2` scratch, `repeat` times (at least once) from the same
+    /// tracker state: the detection, the median wall time of the step alone in
+    /// microseconds; the tracker is left as after one step. A repeated step starts
+    /// from a copy of the state (8 KiB: well under a microsecond, inside the timed
+    /// call).
     ///
     /// # Errors
     /// As [`DetectorBank::detect`].
@@ -210,22 +192,22 @@ impl DetectorBank {
         if let Params::AutoV2(v2) = self.params(Method::AutoV2) {
             tracker.detector = v2;
         }
+        self.make_room(frame);
         let start = tracker.clone();
         let mut after: Option<Tracker> = None;
-        let scratches = &mut self.tracker_scratch;
         let timed = timed_median(repeat, || {
             let mut t = start.clone();
             let d = if fits::<tirroi_core::Reference>(frame) {
-                t.step(frame, scratches.reference.get_or_insert_with(fresh_scratch))
+                t.step(frame, self.scratch.auto_v2())
             } else if fits::<Cap640x512>(frame) {
                 t.step(
                     frame,
-                    scratches.cap_640x512.get_or_insert_with(fresh_scratch),
+                    self.scratch_640x512.get_or_insert_with(new_bank).auto_v2(),
                 )
             } else {
                 t.step(
                     frame,
-                    scratches.cap_1024x768.get_or_insert_with(fresh_scratch),
+                    self.scratch_1024x768.get_or_insert_with(new_bank).auto_v2(),
                 )
             }?;
             after.get_or_insert(t);

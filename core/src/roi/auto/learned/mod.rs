@@ -1211,7 +1211,7 @@ impl AutoV2 {
         work.candidate = None;
         let d = self.region_stages(frame, work, win, plane8, lv);
         if d.roi.is_some() {
-            work.candidate = None;
+            // (A candidate is kept only with "no target".)
             return d;
         }
         let d = if self.spot {
