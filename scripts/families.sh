@@ -13,6 +13,8 @@
 #              famAT  realistic-tango, 300, seed 7001
 #   held out:  famB   realistic, 600, seed 9001      famBT  realistic-tango, 300, seed 9001
 #              paperB paper, 300, seed 9001
+#              famBW  realistic-winged, 1 200, seed 9001: a target shape (a small satellite
+#                     with two solar wings) no model was trained or tuned on
 #              ts-fixtures, ts-dark, ts-real-earth: `tirroi testset --kind ...`, 200, seed 16
 #              (the real dark frame and the real Earth image; they never choose)
 #   approach sequences (`track`; `eval` and `compare` leave them out):
@@ -68,7 +70,7 @@ else
 fi
 
 family_a=(famA paperA fixA famAF famAE famAT)
-held_out=(famB famBT paperB ts-fixtures ts-dark ts-real-earth)
+held_out=(famB famBT paperB famBW ts-fixtures ts-dark ts-real-earth)
 
 # "family A" or "held out": the set's role in a choice.
 role_of() {
@@ -131,6 +133,7 @@ case $cmd in
         render_set famB render --preset realistic --count 600 --seed 9001 --masks
         render_set famBT render --preset realistic-tango --count 300 --seed 9001 --masks
         render_set paperB render --preset paper --count 300 --seed 9001 --masks
+        render_set famBW render --preset realistic-winged --count 1200 --seed 9001
         for kind in fixtures dark real-earth; do
             render_set "ts-$kind" testset --kind "$kind" --count 200 --seed 16
         done

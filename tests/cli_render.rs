@@ -47,6 +47,16 @@ attitude_deg = [10.0, 20.0, 30.0]
 offset_px = [10.0, -5.0]
 noise = false
 earth = false
+
+[[scene]]
+name = "winged-fixed"
+count = 1
+target = "winged-sat"
+range_m = 20.0
+attitude_deg = [10.0, 20.0, 30.0]
+offset_px = [10.0, -5.0]
+noise = false
+earth = false
 "#;
 
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
@@ -89,7 +99,7 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     let a = tmp.path().join("a");
     let b = tmp.path().join("b");
     let report = render_into(&config, &a, "1", &["--masks", "--preview"]);
-    assert!(report.contains("6 images rendered"), "{report}");
+    assert!(report.contains("7 images rendered"), "{report}");
     assert!(report.contains("per-image CPU time by stage"), "{report}");
     render_into(&config, &b, "2", &["--masks", "--preview"]);
     let fa = files(&a);
@@ -98,9 +108,9 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     for (name, bytes) in &fa {
         assert!(bytes == &fb[name], "{name} differs between 1 and 2 threads");
     }
-    // 6 PNG + 6 masks + 6 previews + truth.csv + coco.json + metadata.jsonl + the run
+    // 7 PNG + 7 masks + 7 previews + truth.csv + coco.json + metadata.jsonl + the run
     // manifest tirroi-run.json, nothing else.
-    assert_eq!(fa.len(), 22, "{:?}", fa.keys().collect::<Vec<_>>());
+    assert_eq!(fa.len(), 25, "{:?}", fa.keys().collect::<Vec<_>>());
     assert!(fa.contains_key("/tirroi-run.json"));
     assert!(
         !fa.keys()
@@ -114,7 +124,7 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     // No sequence in the file, no sequence columns.
     assert!(header.ends_with(",visible_share"), "{header}");
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 6);
+    assert_eq!(rows.len(), 7);
     for r in &rows {
         let b: Vec<u16> = r[1..5].iter().map(|v| v.parse().unwrap()).collect();
         assert!(
@@ -134,6 +144,12 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     // Poses enumerate material × illumination: the second pose is multi-2, sunlit.
     assert_eq!((rows[4][8], rows[4][9]), ("multi-2", "sunlit"));
     assert_eq!(rows[5][7], "tango");
+    // The winged satellite, no Table 3 material case; its wings stretch the box (2.9 m
+    // span against a 0.6 m bus, 0.78 m with its radome).
+    assert_eq!((rows[6][7], rows[6][8]), ("winged-sat", ""));
+    let w: Vec<f64> = rows[6][1..5].iter().map(|v| v.parse().unwrap()).collect();
+    let (bw, bh) = (w[2] - w[0], w[3] - w[1]);
+    assert!(bw.max(bh) >= 2.5 * bw.min(bh), "{:?}", rows[6]);
 
     // The PNG is the DN the metadata describes: 16-bit, 328 × 248, inside 14 bits.
     let img = image::load_from_memory(&fa["/000000.png"])
@@ -157,8 +173,8 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
     assert_eq!(vec![x0, y0, x1, y1], b);
 
     let coco: serde_json::Value = serde_json::from_slice(&fa["/coco.json"]).unwrap();
-    assert_eq!(coco["images"].as_array().unwrap().len(), 6);
-    assert_eq!(coco["annotations"].as_array().unwrap().len(), 6);
+    assert_eq!(coco["images"].as_array().unwrap().len(), 7);
+    assert_eq!(coco["annotations"].as_array().unwrap().len(), 7);
     let ann = &coco["annotations"][0];
     assert_eq!(ann["bbox"][0].as_u64().unwrap() as u32, b[0]);
     assert_eq!(ann["bbox"][2].as_u64().unwrap() as u32, b[2] - b[0]);
@@ -167,7 +183,7 @@ fn small_dataset_is_labelled_and_deterministic_across_thread_counts() {
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    assert_eq!(meta.len(), 6);
+    assert_eq!(meta.len(), 7);
     assert!(meta[0]["earth_fraction"].as_f64().unwrap() > 0.0);
     assert_eq!(meta[5]["earth_fraction"].as_f64().unwrap(), 0.0);
     assert_eq!(meta[5]["noise_sigma_dn"].as_f64().unwrap(), 0.0);
@@ -201,7 +217,7 @@ sequence = { frames = 3, range_end_m = 20.0, drift_px = 30.0, spin_deg = 20.0 }
     .unwrap();
     let out = tmp.path().join("out");
     let report = render_into(&config, &out, "2", &[]);
-    assert!(report.contains("6 images rendered"), "{report}");
+    assert!(report.contains("7 images rendered"), "{report}");
     let truth = fs::read_to_string(out.join("truth.csv")).unwrap();
     let mut lines = truth.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -343,7 +359,7 @@ fn presets_list_and_print_as_toml_that_parses_back() {
     let o = run(&["render", "--list-presets"]);
     assert!(o.status.success());
     let list = String::from_utf8_lossy(&o.stdout);
-    for p in ["paper", "tango", "quick"] {
+    for p in ["paper", "tango", "quick", "realistic-winged"] {
         assert!(list.contains(p), "{list}");
     }
     let o = run(&[

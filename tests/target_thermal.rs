@@ -257,6 +257,7 @@ fn isolated_plate_matches_radiative_equilibrium() {
         ir_emissivity: 0.6,
         conductivity_w_m_k: 0.0,
         thickness_m: 0.0,
+        core_conductance_w_m2_k: 0.0,
     });
     for sun_deg in [0.0_f64, 60.0] {
         let sun = [sun_deg.to_radians().sin(), 0.0, sun_deg.to_radians().cos()];
@@ -289,6 +290,7 @@ fn isothermal_box_with_dissipation_only() {
         ir_emissivity: 0.8,
         conductivity_w_m_k: 400.0,
         thickness_m: 0.25,
+        core_conductance_w_m2_k: 0.0,
     };
     let part = Part {
         name: "walls",
@@ -468,6 +470,7 @@ fn degenerate_input_is_an_error_not_a_panic() {
         ir_emissivity: 0.5,
         conductivity_w_m_k: 1.0,
         thickness_m: 1e-3,
+        core_conductance_w_m2_k: 0.0,
     };
     let env = sun_earth();
     let mut zero_area = plate(good);
@@ -531,6 +534,14 @@ fn degenerate_input_is_an_error_not_a_panic() {
             thickness_m: f64::INFINITY,
             ..good
         },
+        Material {
+            core_conductance_w_m2_k: -1.0,
+            ..good
+        },
+        Material {
+            core_conductance_w_m2_k: f64::NAN,
+            ..good
+        },
     ] {
         assert!(matches!(
             solve_steady_state(&plate(material), &env),
@@ -583,6 +594,7 @@ fn enclosed_dissipation_has_no_steady_state() {
         ir_emissivity: 0.5,
         conductivity_w_m_k: 100.0,
         thickness_m: 1e-3,
+        core_conductance_w_m2_k: 0.0,
     };
     let outer = closed_box(
         [2.0, 2.0, 2.0],
@@ -733,6 +745,7 @@ fn random_soups_solve_or_refuse() {
                     ir_emissivity: 0.01 + 0.99 * rnd(),
                     conductivity_w_m_k: 200.0 * rnd(),
                     thickness_m: 0.01 * rnd(),
+                    core_conductance_w_m2_k: 0.0,
                 },
                 dissipation_w: if case % 3 == 0 { 10.0 * rnd() } else { 0.0 },
             },
@@ -744,6 +757,7 @@ fn random_soups_solve_or_refuse() {
                     ir_emissivity: 0.01 + 0.99 * rnd(),
                     conductivity_w_m_k: 0.0,
                     thickness_m: 0.0,
+                    core_conductance_w_m2_k: 0.0,
                 },
                 dissipation_w: 0.0,
             },

@@ -45,6 +45,7 @@ fn plate(side_m: f64) -> Mesh {
                 ir_emissivity: 0.9,
                 conductivity_w_m_k: 100.0,
                 thickness_m: 0.002,
+                core_conductance_w_m2_k: 0.0,
             },
             dissipation_w: 0.0,
         }],

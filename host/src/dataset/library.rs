@@ -26,7 +26,7 @@ use crate::world::scene::{
 use crate::world::spacecraft::thermal::{TRANSIENT_STEP_S, facet_heat_capacities_j_k};
 use crate::world::spacecraft::{
     MaterialCase, Mesh, ThermalEnvironment, ThermalNetwork, cube_cylinder, solve_steady_state,
-    tango,
+    tango, winged_sat,
 };
 
 /// A thermal solution with the numbers the labels report.
@@ -154,6 +154,7 @@ impl Library {
                 let mesh = match t {
                     TargetModel::CubeCylinder => cube_cylinder(m, r),
                     TargetModel::Tango => tango(r),
+                    TargetModel::WingedSat => winged_sat(r),
                 };
                 ((t, m, res), Arc::new(mesh))
             })

@@ -352,7 +352,8 @@ pub fn plan(file: &SceneFile) -> Vec<ImagePlan> {
         };
         let materials = match spec.target {
             TargetModel::CubeCylinder => spec.material.values(),
-            TargetModel::Tango => vec![MaterialCase::Mono],
+            // Their own materials: one case, not the Table 3 ones.
+            TargetModel::Tango | TargetModel::WingedSat => vec![MaterialCase::Mono],
         };
         let lights = spec.illumination.values();
         // Whole poses, and a last partial one (its first `count mod scales` scales, or

@@ -33,14 +33,19 @@ pub enum TargetModel {
     CubeCylinder,
     /// A Tango-like satellite (PRISMA, Section 5).
     Tango,
+    /// A generic small satellite with two solar wings (2.9 m span; not in the paper):
+    /// a shape the learned detector never saw in training
+    /// ([`crate::world::spacecraft::models::winged_sat`]).
+    WingedSat,
 }
 
 impl TargetModel {
-    /// "cube-cylinder" or "tango".
+    /// "cube-cylinder", "tango" or "winged-sat".
     pub fn label(&self) -> &'static str {
         match self {
             TargetModel::CubeCylinder => "cube-cylinder",
             TargetModel::Tango => "tango",
+            TargetModel::WingedSat => "winged-sat",
         }
     }
 
@@ -50,6 +55,7 @@ impl TargetModel {
         match self {
             TargetModel::CubeCylinder => 0.05,
             TargetModel::Tango => 0.05,
+            TargetModel::WingedSat => 0.05,
         }
     }
 
@@ -58,10 +64,13 @@ impl TargetModel {
     /// is what keeps an edge-cut target in view. Cube + cylinder: 0.25 m (the origin is
     /// the centre of the joint face; the Ø 0.5 m cylinder and the 1 m cube hold the
     /// ball). Tango: 0.14 m (the 0.295 m bus, the origin within 3 mm of its mid-plane).
+    /// Winged satellite: 0.29 m (the 0.6 × 0.6 × 0.7 m bus, the origin 40 mm below its
+    /// centre, 0.30 m from its walls).
     pub fn inner_half_size_m(&self) -> f64 {
         match self {
             TargetModel::CubeCylinder => 0.25,
             TargetModel::Tango => 0.14,
+            TargetModel::WingedSat => 0.29,
         }
     }
 }

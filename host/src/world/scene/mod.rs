@@ -17,7 +17,7 @@
 //! count = 6
 //! mode = "detection"            # or "radiometry"
 //! scale = [1, 2, 3]             # Table 5; every pose is rendered at each scale
-//! target = "cube-cylinder"      # or "tango"
+//! target = "cube-cylinder"      # or "tango", "winged-sat"
 //! material = "mono"             # Table 3: "mono", "multi-1", "multi-2"
 //! range_m = { min = 15.0, max = 50.0 }
 //! illumination = ["sunlit", "eclipse"]
@@ -102,7 +102,7 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// The built-in presets: name, description, TOML.
-pub const PRESETS: [(&str, &str, &str); 6] = [
+pub const PRESETS: [(&str, &str, &str); 7] = [
     (
         "paper",
         "Section 4.1: 12 000 cube+cylinder images, radiometry (3 material cases) and detection (Scales 1-3), close 15-50 m and far 340-440 m, sunlit and eclipse",
@@ -132,6 +132,11 @@ pub const PRESETS: [(&str, &str, &str); 6] = [
         "realistic-approach",
         "approach sequences in the realistic world (2 448 images: 102 sequences of 24 frames, range closing, the target drifting and turning, the ground sliding; 10 % without a target): a tracker's test",
         include_str!("../../../presets/realistic-approach.toml"),
+    ),
+    (
+        "realistic-winged",
+        "the realistic world's four scene kinds (1 200 images) with a target no detector was trained on: a small satellite with two solar wings",
+        include_str!("../../../presets/realistic-winged.toml"),
     ),
 ];
 

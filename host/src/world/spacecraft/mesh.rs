@@ -25,6 +25,11 @@ pub struct Material {
     /// In-plane conducting thickness of the skin or panel, m (≥ 0): the facet network
     /// conducts k·t W K⁻¹ per square.
     pub thickness_m: f64,
+    /// Conductance through a sandwich panel's core from this face to the opposite one,
+    /// W m⁻² K⁻¹ (≥ 0): the thermal network links a facet to the facet its inward ray
+    /// meets within [`crate::world::spacecraft::thermal::CORE_MAX_DEPTH_M`] (the panel's
+    /// other face). 0: a skin whose faces meet only along the panel's edges.
+    pub core_conductance_w_m2_k: f64,
 }
 
 /// A named group of facets with one material (and optional internal dissipation).
@@ -447,6 +452,7 @@ mod tests {
         ir_emissivity: 0.5,
         conductivity_w_m_k: 167.0,
         thickness_m: 1e-3,
+        core_conductance_w_m2_k: 0.0,
     };
 
     fn edge_uses(mesh: &Mesh) -> HashMap<(u32, u32), usize> {

@@ -1,6 +1,7 @@
 //! The two targets of the paper: the cube + cylinder of Section 4.1 (Table 3 material
-//! cases) and a Tango-like satellite (PRISMA's Tango, Section 5), plus a closed box for
-//! calibration and tests.
+//! cases) and a Tango-like satellite (PRISMA's Tango, Section 5); a generic small
+//! satellite with two solar wings ([`winged_sat`], a shape the detectors were not
+//! trained on); and a closed box for calibration and tests.
 //!
 //! # Cube + cylinder sizes and the 9-pixel rule
 //!
@@ -74,6 +75,16 @@ pub const ALUMINIUM_SPECIFIC_HEAT_J_KG_K: f64 = 896.0;
 /// honeycomb, 3/16 in cells, 49.7 kg m⁻³ (3.1 lb ft⁻³, Hexcel HexWeb CR-III data
 /// sheet): 0.75 kg m⁻² × 896 J kg⁻¹ K⁻¹.
 pub const HONEYCOMB_CORE_J_M2_K: f64 = 0.015 * 49.7 * ALUMINIUM_SPECIFIC_HEAT_J_KG_K;
+
+/// Conductance through a 25 mm aluminium honeycomb core from one face sheet to the other,
+/// W m⁻² K⁻¹: the core's foils conduct as a solid of the core's density share of
+/// aluminium, k ≈ 167 × 49.7 / 2700 ≈ 3.1 W m⁻¹ K⁻¹ (the core of
+/// [`HONEYCOMB_CORE_J_M2_K`]; radiation inside the cells adds little at these
+/// temperatures), over 25 mm: ≈ 123 (honeycomb panels' through-conductances are quoted at
+/// 50–150, Gilmore, Vol. I, ch. 5). A sunlit wing's back then runs 4–5 K below its
+/// cells instead of the ~60 K of two faces joined only along the panel's edges.
+pub const HONEYCOMB_THROUGH_W_M2_K: f64 =
+    ALUMINIUM_CONDUCTIVITY_W_M_K * (49.7 / ALUMINIUM_DENSITY_KG_M3) / 0.025;
 
 /// Areal heat capacity added by the solar cells, J m⁻² K⁻¹: triple-junction GaAs/Ge
 /// cells of about 0.86 kg m⁻² (Azur Space 3G30C data sheet: 86 mg cm⁻²) at
@@ -179,6 +190,7 @@ pub fn grey_aluminium_skin(name: &'static str, emissivity: f64) -> Material {
         ir_emissivity: emissivity,
         conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
         thickness_m: 2e-3,
+        core_conductance_w_m2_k: 0.0,
     }
 }
 
@@ -266,6 +278,7 @@ pub const SOLAR_CELLS: Material = Material {
     ir_emissivity: 0.85,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 1e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Tango panel edges and overhanging underside: black paint (Aeroglaze Z306, Gilmore
@@ -276,6 +289,7 @@ pub const PANEL_BACK: Material = Material {
     ir_emissivity: 0.87,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 1e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Tango ±y walls: white-paint radiators (silicone white S13G/LO-1, Gilmore App. A:
@@ -286,6 +300,7 @@ pub const WHITE_PAINT: Material = Material {
     ir_emissivity: 0.85,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 1e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Tango ±x walls and −z face: MLI blankets with an aluminised-Kapton outer layer,
@@ -298,6 +313,7 @@ pub const MLI_KAPTON: Material = Material {
     ir_emissivity: 0.67,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 1e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Tango whip antennas: polished metal, α = 0.30, ε = 0.08 (between polished aluminium,
@@ -310,6 +326,7 @@ pub const POLISHED_METAL: Material = Material {
     ir_emissivity: 0.08,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 2.5e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Tango patch antennas: white radome (white paint class, α = 0.25, ε = 0.85, estimate)
@@ -320,6 +337,7 @@ pub const WHITE_RADOME: Material = Material {
     ir_emissivity: 0.85,
     conductivity_w_m_k: ALUMINIUM_CONDUCTIVITY_W_M_K,
     thickness_m: 1e-3,
+    core_conductance_w_m2_k: 0.0,
 };
 
 /// Bus size of [`tango`] (x, y, z), m: 570 × 740 × 295 mm envelope.
@@ -472,6 +490,168 @@ pub fn tango(resolution_m: f64) -> Mesh {
     b.finish()
 }
 
+/// Bus size of [`winged_sat`] (x, y, z), m: a generic small satellite of the 100–150 kg
+/// class (*estimate*: the envelope of SSTL-100/150-type buses, 0.6 × 0.6 × 0.7 m).
+pub const WINGED_BUS_M: Vec3 = [0.6, 0.6, 0.7];
+/// Size of each of [`winged_sat`]'s two solar wings (thickness along x, length along y,
+/// height along z), m (*estimate*: 0.6 m² of cells per wing, a 25 mm honeycomb panel as
+/// Tango's).
+pub const WINGED_WING_M: Vec3 = [0.025, 1.0, 0.6];
+/// Gap between the bus's ±y wall and a wing's inner edge, bridged by the wing's yoke, m
+/// (*estimate*).
+pub const WINGED_YOKE_M: f64 = 0.15;
+/// Yoke diameter, m (*estimate*: a Ø 30 mm tube, modelled as a closed-end rod).
+pub const WINGED_YOKE_DIAMETER_M: f64 = 0.03;
+/// The TT&C antenna on the bus's +z face: a white radome box (x, y, z), m (*estimate*).
+pub const WINGED_ANTENNA_M: Vec3 = [0.12, 0.12, 0.08];
+/// Internal dissipation of [`winged_sat`]'s bus, W (*estimate*: about the orbit average
+/// of 1.2 m² of triple-junction cells, ~450 W at normal incidence, over a sunlit
+/// fraction of 0.6 at an average cosine of 0.6, all of it ending as heat in the bus).
+pub const WINGED_DISSIPATION_W: f64 = 150.0;
+
+/// A generic small satellite with two deployed solar wings: the silhouette of most
+/// inspection and servicing clients, and a shape none of `auto-v2`'s training sets
+/// holds (the cube + cylinder and Tango are its training targets), so scores on it say
+/// how the detector carries to a body it has never seen.
+///
+/// Box bus ([`WINGED_BUS_M`]), its ±x walls white-paint radiators ([`WHITE_PAINT`]),
+/// the ±y walls and −z face MLI ([`MLI_KAPTON`]), the +z face MLI under a TT&C radome
+/// ([`WINGED_ANTENNA_M`], [`WHITE_RADOME`]); two wings in the y–z plane, cells on
+/// their +x face ([`SOLAR_CELLS`]), the −x face and edges black paint ([`PANEL_BACK`]),
+/// the two faces joined through the panel's core ([`HONEYCOMB_THROUGH_W_M2_K`]),
+/// each held [`WINGED_YOKE_M`] off the bus's ±y wall by a yoke ([`POLISHED_METAL`]).
+/// The yokes are joined to the bus (their open base lies on its wall) and end in a cap
+/// at the wing: the wings exchange heat by radiation only, as real arrays, thermally
+/// decoupled from the bus at their hinges, nearly do.
+///
+/// Parts: 0 `"bus-radiator"`, 1 `"bus-mli"` ([`WINGED_DISSIPATION_W`] split between
+/// the two by area), 2 `"solar-cells"`, 3 `"panel-back"`, 4 `"yokes"`, 5 `"antenna"`.
+/// Body frame: wings along ±y, cells facing +x, the radome on +z; origin at the
+/// bounding-box centre (2.9 × 0.6 × 0.78 m overall). `resolution_m` as for
+/// [`cube_cylinder`] (yokes: at least 8 segments).
+pub fn winged_sat(resolution_m: f64) -> Mesh {
+    let res = clamp_resolution(resolution_m);
+    let [bx, by, bz] = WINGED_BUS_M;
+    let [wx, wy, wz] = WINGED_WING_M;
+    let [ax, ay, az] = WINGED_ANTENNA_M;
+    let (hx, hy) = (bx / 2.0, by / 2.0);
+    // z: the bus and the radome on it, centred as a whole.
+    let z0 = -(bz + az) / 2.0;
+    let z_top = z0 + bz;
+    let z_mid = z0 + bz / 2.0;
+
+    let radiator_area = 2.0 * by * bz;
+    let mli_area = 2.0 * bx * bz + 2.0 * bx * by;
+    let share = WINGED_DISSIPATION_W / (radiator_area + mli_area);
+
+    let mut b = MeshBuilder::new();
+    let radiator = b.part(Part {
+        name: "bus-radiator",
+        material: WHITE_PAINT,
+        dissipation_w: share * radiator_area,
+    });
+    let mli = b.part(Part {
+        name: "bus-mli",
+        material: MLI_KAPTON,
+        dissipation_w: share * mli_area,
+    });
+    // The wings' faces conduct through their honeycomb core (Tango's body-mounted panel
+    // is modelled without it, as in the paper's case study).
+    let cells = b.part(Part {
+        name: "solar-cells",
+        material: Material {
+            core_conductance_w_m2_k: HONEYCOMB_THROUGH_W_M2_K,
+            ..SOLAR_CELLS
+        },
+        dissipation_w: 0.0,
+    });
+    let back = b.part(Part {
+        name: "panel-back",
+        material: Material {
+            core_conductance_w_m2_k: HONEYCOMB_THROUGH_W_M2_K,
+            ..PANEL_BACK
+        },
+        dissipation_w: 0.0,
+    });
+    let yokes = b.part(Part {
+        name: "yokes",
+        material: POLISHED_METAL,
+        dissipation_w: 0.0,
+    });
+    let antenna = b.part(Part {
+        name: "antenna",
+        material: WHITE_RADOME,
+        dissipation_w: 0.0,
+    });
+
+    // Bus: closed (the radome sits on its +z face).
+    b.box_faces(
+        [-hx, -hy, z0],
+        [hx, hy, z_top],
+        [
+            Some(radiator),
+            Some(radiator),
+            Some(mli),
+            Some(mli),
+            Some(mli),
+            Some(mli),
+        ],
+        res,
+    );
+    // Radome, open at its base on the bus's +z face.
+    b.box_faces(
+        [-ax / 2.0, -ay / 2.0, z_top],
+        [ax / 2.0, ay / 2.0, z_top + az],
+        [
+            Some(antenna),
+            Some(antenna),
+            Some(antenna),
+            Some(antenna),
+            None,
+            Some(antenna),
+        ],
+        res,
+    );
+    let r = WINGED_YOKE_DIAMETER_M / 2.0;
+    for side in [-1.0, 1.0] {
+        // Wing: y from the yoke's end outwards, cells on +x.
+        let (y_in, y_out) = (hy + WINGED_YOKE_M, hy + WINGED_YOKE_M + wy);
+        let (ya, yb) = if side > 0.0 {
+            (y_in, y_out)
+        } else {
+            (-y_out, -y_in)
+        };
+        b.box_faces(
+            [-wx / 2.0, ya, z_mid - wz / 2.0],
+            [wx / 2.0, yb, z_mid + wz / 2.0],
+            [
+                Some(back),
+                Some(cells),
+                Some(back),
+                Some(back),
+                Some(back),
+                Some(back),
+            ],
+            res,
+        );
+        // Yoke: from the bus wall to the wing's inner edge, capped there.
+        b.cylinder(
+            yokes,
+            CylinderSpec {
+                base: [0.0, side * hy, z_mid],
+                axis: [0.0, side, 0.0],
+                radius_m: r,
+                length_m: WINGED_YOKE_M,
+                base_plane_normal: [0.0, side, 0.0],
+                segments: segments(std::f64::consts::TAU * r, res, 8),
+                rings: divisions(WINGED_YOKE_M, res, 1),
+                cap_rings: 1,
+            },
+        );
+    }
+    b.finish()
+}
+
 /// A closed axis-aligned box of size `size_m` (x, y, z, m, each > 0) made of one part,
 /// centred on the origin, at facet size `resolution_m` (as for [`cube_cylinder`]):
 /// a calibration target for the thermal network (e.g. the isothermal check).
@@ -499,6 +679,43 @@ mod tests {
             assert_eq!(json, format!("\"{}\"", c.label()));
             assert_eq!(serde_json::from_str::<MaterialCase>(&json).unwrap(), c);
         }
+    }
+
+    /// The winged satellite's body frame: origin at the bounding-box centre, 2.9 × 0.6 ×
+    /// 0.78 m overall (wings, bus, radome), and the ball of
+    /// `TargetModel::WingedSat.inner_half_size_m()` inside the bus.
+    #[test]
+    fn winged_sat_is_centred_and_holds_its_inner_ball() {
+        use crate::world::scene::TargetModel;
+        let mesh = winged_sat(DEFAULT_RESOLUTION_M);
+        let mut lo = [f64::MAX; 3];
+        let mut hi = [f64::MIN; 3];
+        for v in &mesh.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        let span = WINGED_BUS_M[1] + 2.0 * (WINGED_YOKE_M + WINGED_WING_M[1]);
+        let height = WINGED_BUS_M[2] + WINGED_ANTENNA_M[2];
+        for (k, size) in [WINGED_BUS_M[0], span, height].into_iter().enumerate() {
+            assert!((hi[k] + lo[k]).abs() < 1e-12, "axis {k}: {lo:?} .. {hi:?}");
+            assert!(
+                (hi[k] - lo[k] - size).abs() < 1e-12,
+                "axis {k}: {lo:?} .. {hi:?}"
+            );
+        }
+        // The bus's walls: ±x, ±y at half its size; −z at the bottom, +z under the radome.
+        let bottom = -height / 2.0;
+        let walls = [
+            WINGED_BUS_M[0] / 2.0,
+            WINGED_BUS_M[1] / 2.0,
+            -bottom,
+            bottom + WINGED_BUS_M[2],
+        ];
+        let inner = TargetModel::WingedSat.inner_half_size_m();
+        assert!(walls.iter().all(|&d| d >= inner), "{walls:?} vs {inner}");
+        assert_eq!(mesh.parts.len(), 6);
     }
 
     #[test]

@@ -27,6 +27,10 @@
 //!   [`CONTACT_TOLERANCE_M`] of another facet B, A and B are coupled through the skins
 //!   in series with a contact conductance [`JOINT_CONDUCTANCE_W_M_K`]·L (joints
 //!   between two open edges of one part count as continuous skin, without it).
+//! - Sandwich cores: a facet whose material has a core conductance h
+//!   ([`crate::world::spacecraft::Material::core_conductance_w_m2_k`]) is linked to the
+//!   facet its inward ray meets first, when that one faces the other way within
+//!   [`CORE_MAX_DEPTH_M`] (the panel's other face): Gᵢⱼ = h·Aᵢ/2 from each side.
 //! - Enclosed facets: a facet whose outward ray first meets the inner side of another
 //!   facet (the cube face under the cylinder, the bus face under a patch antenna) is
 //!   inside the body: it conducts, carries its share of dissipation, but neither
@@ -111,6 +115,11 @@ use illumination::Bvh;
 /// interface conductance of about 1000 W m⁻² K⁻¹ (bare aluminium joints span
 /// 200–2000 W m⁻² K⁻¹, Gilmore, *Spacecraft Thermal Control Handbook*, Vol. I, ch. 5).
 pub const JOINT_CONDUCTANCE_W_M_K: f64 = 20.0;
+
+/// Deepest sandwich panel, m: a cored facet whose opposite face lies farther inward is
+/// a wall of a box, not a panel's face, and gets no core link (honeycomb panels of
+/// spacecraft are 10–50 mm thick).
+pub const CORE_MAX_DEPTH_M: f64 = 0.1;
 
 /// Largest distance between an open edge's midpoint and a facet for the two to be
 /// joined, m.

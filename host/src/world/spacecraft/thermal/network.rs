@@ -1,5 +1,6 @@
 //! Building the network of a mesh ([`ThermalNetwork::new`]): facet geometry, shared
-//! edges and their conductances, joints between attached parts, exposure of every
+//! edges and their conductances, joints between attached parts, sandwich cores between
+//! a panel's two faces, exposure of every
 //! facet (enclosed facets neither absorb nor emit).
 
 use super::ThermalNetwork;
@@ -7,7 +8,7 @@ use std::collections::HashMap;
 
 use super::error::ThermalError;
 use super::illumination::{Bvh, point_line_distance, point_segment_distance};
-use super::{CONTACT_TOLERANCE_M, JOINT_CONDUCTANCE_W_M_K};
+use super::{CONTACT_TOLERANCE_M, CORE_MAX_DEPTH_M, JOINT_CONDUCTANCE_W_M_K};
 use crate::world::geom::{add, cross, dot, norm, scale, sub};
 use crate::world::spacecraft::mesh::Mesh;
 
@@ -56,6 +57,9 @@ impl ThermalNetwork {
             }
             if !(m.thickness_m.is_finite() && m.thickness_m >= 0.0) {
                 return bad("thickness negative or not finite");
+            }
+            if !(m.core_conductance_w_m2_k.is_finite() && m.core_conductance_w_m2_k >= 0.0) {
+                return bad("core conductance negative or not finite");
             }
             if !(part.dissipation_w.is_finite() && part.dissipation_w >= 0.0) {
                 return bad("dissipation negative or not finite");
@@ -189,6 +193,26 @@ impl ThermalNetwork {
                     .entry((i.min(j) as u32, i.max(j) as u32))
                     .or_insert(0.0) += g;
                 joints += 1;
+            }
+        }
+
+        // Sandwich cores: a facet of a cored material to the facet its inward ray meets
+        // first, when that faces the other way (the panel's other face) within
+        // CORE_MAX_DEPTH_M; h·A/2 from each side, so a pair of aligned faces links h·A.
+        for i in 0..n {
+            let h = mat(i).core_conductance_w_m2_k;
+            if h <= 0.0 {
+                continue;
+            }
+            let inward = scale(normal[i], -1.0);
+            let o = add(centroid[i], scale(inward, ray_eps));
+            if let Some((j, depth)) = bvh.closest_hit(o, inward, i)
+                && depth <= CORE_MAX_DEPTH_M
+                && dot(normal[j], normal[i]) < 0.0
+            {
+                *links
+                    .entry((i.min(j) as u32, i.max(j) as u32))
+                    .or_insert(0.0) += 0.5 * h * area[i];
             }
         }
 

@@ -7,7 +7,7 @@ use super::solver::CgWork;
 use super::*;
 
 use crate::world::spacecraft::mesh::{Material, MeshBuilder, Part};
-use crate::world::spacecraft::models::{MaterialCase, cube_cylinder, tango};
+use crate::world::spacecraft::models::{MaterialCase, cube_cylinder, tango, winged_sat};
 
 fn sheet(kt_w_k: f64) -> Material {
     Material {
@@ -16,6 +16,7 @@ fn sheet(kt_w_k: f64) -> Material {
         ir_emissivity: 0.5,
         conductivity_w_m_k: kt_w_k / 1e-3,
         thickness_m: 1e-3,
+        core_conductance_w_m2_k: 0.0,
     }
 }
 
@@ -241,4 +242,121 @@ fn tango_is_joined_without_free_edges() {
         })
         .sum();
     assert!(enclosed > 0.01 && enclosed < 0.04, "enclosed {enclosed} m²");
+}
+
+/// The winged satellite: bus, radome and yokes one conducting body; each wing its own
+/// (joined to nothing but its yoke's cap, against which it only touches); no free
+/// edges; enclosed only the bus top under the radome, and the yokes' caps and the wings'
+/// inner edges where the two touch.
+#[test]
+fn winged_sat_wings_are_decoupled_from_the_bus() {
+    let mesh = winged_sat(0.05);
+    let net = ThermalNetwork::new(&mesh).unwrap();
+    assert_eq!(net.free_edge_count(), 0);
+    assert_eq!(net.component_count(), 3);
+    let mut enclosed = 0.0;
+    for t in (0..mesh.facet_count()).filter(|&t| !net.is_exposed(t)) {
+        let (part, n) = (mesh.parts[mesh.part_of[t] as usize].name, mesh.normal(t));
+        match part {
+            "bus-mli" => assert!(n[2] > 1.0 - 1e-12, "{t}: {n:?}"),
+            "panel-back" | "yokes" => assert!(n[1].abs() > 1.0 - 1e-12, "{t}: {n:?}"),
+            _ => panic!("{t}: enclosed facet of {part}"),
+        }
+        enclosed += mesh.area_m2(t);
+    }
+    // The radome's 0.12 × 0.12 m footprint, as whole 0.05 m facets under it.
+    assert!((0.005..0.02).contains(&enclosed), "enclosed {enclosed} m²");
+}
+
+/// A wing square to the Sun, nothing else around (no Earth): its two faces against a
+/// one-dimensional sandwich in closed form, αS = ε_f σ T_f⁴ + h (T_f − T_b) and
+/// h (T_f − T_b) = ε_b σ T_b⁴ (1 + e), the black edges radiating at the back's
+/// temperature (e: their area over a face's, 0.08 / 0.6 m²; solved by bisection), and
+/// each wing's energy balance: the sunlight its cells absorb is what it emits.
+#[test]
+fn winged_sat_sunlit_wing_matches_a_sandwich_in_closed_form() {
+    use crate::world::spacecraft::models::{
+        HONEYCOMB_THROUGH_W_M2_K, PANEL_BACK, SOLAR_CELLS, WINGED_BUS_M, WINGED_WING_M,
+    };
+    let mesh = winged_sat(0.05);
+    let net = ThermalNetwork::new(&mesh).unwrap();
+    let mut env = ThermalEnvironment::sunlit([1.0, 0.0, 0.0], [0.0, 0.0, -1.0]);
+    env.earth_olr_w_m2 = 0.0;
+    env.albedo = 0.0;
+    let sol = net.solve(&env).unwrap();
+    let (h, s) = (HONEYCOMB_THROUGH_W_M2_K, SOLAR_CONSTANT_W_M2);
+    let [wx, wy, wz] = WINGED_WING_M;
+    let edges = 2.0 * (wy + wz) * wx / (wy * wz);
+    let (a, ef, eb) = (
+        SOLAR_CELLS.solar_absorptivity,
+        SOLAR_CELLS.ir_emissivity,
+        PANEL_BACK.ir_emissivity,
+    );
+    // T_b from the back face's balance given T_f, then T_f by bisection on the front's.
+    let back = |tf: f64| {
+        let (mut lo, mut hi) = (0.0f64, tf);
+        for _ in 0..200 {
+            let tb = 0.5 * (lo + hi);
+            if h * (tf - tb) > (1.0 + edges) * eb * STEFAN_BOLTZMANN_W_M2_K4 * tb.powi(4) {
+                lo = tb;
+            } else {
+                hi = tb;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let (mut lo, mut hi) = (100.0f64, 500.0f64);
+    for _ in 0..200 {
+        let tf = 0.5 * (lo + hi);
+        let out = ef * STEFAN_BOLTZMANN_W_M2_K4 * tf.powi(4) + h * (tf - back(tf));
+        if out < a * s {
+            lo = tf;
+        } else {
+            hi = tf;
+        }
+    }
+    let (tf, tb) = (0.5 * (lo + hi), back(0.5 * (lo + hi)));
+    assert!(tf - tb > 3.0 && tf - tb < 6.0, "closed form {tf} / {tb}");
+    let hy = WINGED_BUS_M[1] / 2.0;
+    for side in [-1.0, 1.0] {
+        let wing: Vec<usize> = (0..mesh.facet_count())
+            .filter(|&t| {
+                let name = mesh.parts[mesh.part_of[t] as usize].name;
+                (name == "solar-cells" || name == "panel-back")
+                    && mesh.centroid(t)[1] * side > hy + 0.1
+            })
+            .collect();
+        let mean = |sign: f64| {
+            let (mut at, mut area) = (0.0, 0.0);
+            for &t in wing.iter().filter(|&&t| mesh.normal(t)[0] * sign > 0.99) {
+                at += sol.temperature_k[t] * mesh.area_m2(t);
+                area += mesh.area_m2(t);
+            }
+            at / area
+        };
+        let (front, rear) = (mean(1.0), mean(-1.0));
+        assert!(
+            (front - tf).abs() < 1.0 && (rear - tb).abs() < 1.0,
+            "wing {side}: faces {front:.2} / {rear:.2} K, closed form {tf:.2} / {tb:.2} K"
+        );
+        let absorbed: f64 = wing
+            .iter()
+            .filter(|&&t| mesh.normal(t)[0] > 0.99)
+            .map(|&t| a * s * mesh.area_m2(t))
+            .sum();
+        let emitted: f64 = wing
+            .iter()
+            .filter(|&&t| net.is_exposed(t))
+            .map(|&t| {
+                mesh.material(t).ir_emissivity
+                    * STEFAN_BOLTZMANN_W_M2_K4
+                    * mesh.area_m2(t)
+                    * (sol.temperature_k[t].powi(4) - env.deep_space_k.powi(4))
+            })
+            .sum();
+        assert!(
+            (emitted - absorbed).abs() < 1e-3 * absorbed,
+            "wing {side}: absorbs {absorbed:.2} W, emits {emitted:.2} W"
+        );
+    }
 }

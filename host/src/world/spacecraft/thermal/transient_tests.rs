@@ -25,6 +25,7 @@ fn plate(emissivity: f64) -> Mesh {
             ir_emissivity: emissivity,
             conductivity_w_m_k: 167.0,
             thickness_m: 2e-3,
+            core_conductance_w_m2_k: 0.0,
         },
         dissipation_w: 0.0,
     });
