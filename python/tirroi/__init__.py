@@ -136,7 +136,7 @@ class Frame:
 
     @property
     def target(self) -> str:
-        """Target model (``cube-cylinder``, ``tango``) or ``none``."""
+        """Target model (``cube-cylinder``, ``tango``, ``winged-sat``) or ``none``."""
         return str(self.metadata["target"])
 
     @property
@@ -238,7 +238,8 @@ def render(
 
     Args:
         preset: a built-in scene set (:func:`presets`: ``paper``, ``tango``,
-            ``quick``, ``realistic``, ``realistic-tango``).
+            ``quick``, ``realistic``, ``realistic-tango``, ``realistic-approach``,
+            ``realistic-winged``).
         config: or a TOML scene file (the format of ``tirroi render --print-config``).
         count: images in total, spread over the scene kinds in proportion (default: the
             preset's or file's), 1..=10 000 000; rounded per kind exactly as the CLI's
