@@ -46,6 +46,46 @@ fn every_cell_keeps_its_flux_within_half_a_percent() {
     assert!(worst < 0.005, "worst cell flux error {worst}");
 }
 
+/// Textured cloud tops (`earth_model.cloud_top_texture_k`, here 3 K per σ) keep each
+/// cell's flux as the flat ones do (within 0.5 %, the same independent sampling), and
+/// they do texture the tops: the cloud-top 5 × 5 σ of a 256-px patch rises.
+#[test]
+fn textured_cloud_tops_keep_the_flux() {
+    use tirroi_host::world::earth::texture_stats::cloud_top_sd;
+    let flat = field(1, 0);
+    let f = field(1, 0).with_cloud_top_texture(3.0);
+    let mut worst = 0.0f64;
+    for (row, col) in [(108usize, 200usize), (109, 201), (90, 138), (91, 139)] {
+        let n = 40;
+        let (mut sum, mut wsum) = (0.0, 0.0);
+        for i in 0..n {
+            let lat = row as f64 - 90.0 + (i as f64 + 0.37) / n as f64;
+            let w = lat.to_radians().cos();
+            for j in 0..n {
+                let lon = col as f64 + (j as f64 + 0.61) / n as f64;
+                let t = f.temperature_at_k(lat, lon);
+                sum += w * STEFAN_BOLTZMANN_W_M2_K4 * t.powi(4);
+                wsum += w;
+            }
+        }
+        let target = f64::from(f.cell_flux_w_m2(row, col));
+        worst = worst.max((sum / wsum / target - 1.0).abs());
+    }
+    assert!(worst < 0.005, "worst cell flux error {worst}");
+    let sd = |field: &CloudField| {
+        let t = sample_patch(field, 20.0, 202.0, 256, 256, PATCH_PX_KM, 0.0);
+        let mut sorted = t.clone();
+        sorted.sort_by(f64::total_cmp);
+        let warm = sorted[(sorted.len() - 1) * 9 / 10];
+        cloud_top_sd(&t, 256, 256, warm)
+    };
+    let (a, b) = (sd(&flat), sd(&f));
+    assert!(
+        b[0] > a[0] + 0.5 && b[1] > a[1],
+        "flat {a:?}, textured {b:?}"
+    );
+}
+
 /// Steps between neighbouring samples that cross a 1° border are no larger than those
 /// inside cells (no seams).
 #[test]
@@ -241,6 +281,40 @@ fn cold_features_count_small_and_mid_elements() {
     let [small, _] = cold_features(&holes, w, h);
     let per = 1e4 / (w * h - 1) as f64;
     assert!((small - per).abs() < 1e-9, "{small}");
+}
+
+/// The cloud-top texture against its definition on a drawn image: a 290 K field (the
+/// warm p90) with a 20 × 20 px cloud 30 K colder carrying a ±a K checkerboard, so
+/// every 5 × 5 window inside it (13 pixels of one sign, 12 of the other: mean offset
+/// a/25) has σ = √(a² − (a/25)²); the windows touching the clear field do not count,
+/// nor those over a pixel without data; a scene without cloud tops gives NaN.
+#[test]
+fn cloud_top_spread_is_measured_inside_the_cloud_only() {
+    use tirroi_host::world::earth::texture_stats::cloud_top_sd;
+    let (w, h, a) = (64usize, 64usize, 3.0);
+    let mut t = vec![290.0; w * h];
+    for y in 20..40 {
+        for x in 20..40 {
+            t[y * w + x] = 260.0 + if (x + y) % 2 == 0 { a } else { -a };
+        }
+    }
+    // A 5×5 window of the checkerboard holds 13 of one sign and 12 of the other.
+    let m: f64 = a / 25.0;
+    let sd = (a * a - m * m).sqrt();
+    let [p50, p90] = cloud_top_sd(&t, w, h, 290.0);
+    assert!(
+        (p50 - sd).abs() < 1e-9 && (p90 - sd).abs() < 1e-9,
+        "{p50} {p90} vs {sd}"
+    );
+    // A colder pixel inside with no data: the windows over it are left out, the rest
+    // unchanged.
+    let mut holes = t.clone();
+    holes[30 * w + 30] = f64::NAN;
+    let [p50, _] = cloud_top_sd(&holes, w, h, 290.0);
+    assert!((p50 - sd).abs() < 1e-9, "{p50}");
+    // Only 10 K colder than the warm reference counts: a 285 K cloud does not.
+    let [p50, p90] = cloud_top_sd(&vec![285.0; w * h], w, h, 290.0);
+    assert!(p50.is_nan() && p90.is_nan());
 }
 
 /// Acceptance of the issue on noise-free BT at 4 km, quantised to 0.5 K, over 8 patches

@@ -10,6 +10,7 @@ use crate::imaging::image_io::read_frame;
 use crate::seed::splitmix64;
 use crate::world::earth::texture_stats::{PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch};
 use crate::world::earth::{CloudField, OlrGrid};
+use crate::world::scene::MAX_CLOUD_TOP_TEXTURE_K;
 
 /// Arguments of `tirroi earth-texture`.
 #[derive(Debug, Args)]
@@ -33,6 +34,10 @@ pub struct EarthTextureArgs {
     /// Patch size, pixels (square).
     #[arg(long, default_value_t = 512)]
     pub size: usize,
+    /// Texture of the cloud tops outside deep convection, K per σ of the finer octaves
+    /// (a scene file's `earth_model.cloud_top_texture_k`), 0..=10.
+    #[arg(long, default_value_t = 0.0)]
+    pub cloud_top_texture_k: f64,
 }
 
 /// Patch centres (latitude°, longitude° E) the statistics sample: the Hawaii sector of
@@ -55,7 +60,7 @@ pub fn builtin_field(seed: u64, day: u64) -> CloudField {
 
 fn row(name: &str, s: &TextureStats) -> String {
     format!(
-        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} |",
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} |",
         s.step2_k[0],
         s.step2_k[1],
         s.step2_k[2],
@@ -71,6 +76,9 @@ fn row(name: &str, s: &TextureStats) -> String {
         s.bt_k[2],
         s.cold_features_per_10k_px[0],
         s.cold_features_per_10k_px[1],
+        s.cloud_top_sd_k[0],
+        s.cloud_top_sd_k[1],
+        100.0 * s.intermediate_share,
     )
 }
 
@@ -99,14 +107,22 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
     if args.size < 64 {
         return Err(format!("--size {}: expected at least 64 px", args.size));
     }
+    if !(0.0..=MAX_CLOUD_TOP_TEXTURE_K).contains(&args.cloud_top_texture_k) {
+        return Err(format!(
+            "--cloud-top-texture-k {}: expected 0..={MAX_CLOUD_TOP_TEXTURE_K} K",
+            args.cloud_top_texture_k
+        ));
+    }
+    let texture =
+        |day| builtin_field(args.seed, day).with_cloud_top_texture(args.cloud_top_texture_k);
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(
-            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px |"
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % |"
         );
-        println!("|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|");
         for day in 0..args.days {
-            let field = builtin_field(args.seed, day);
+            let field = texture(day);
             for &(lat, lon) in &PATCH_CENTRES {
                 let t = sample_patch(
                     &field,
@@ -124,7 +140,7 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
         }
         // Per-point cost with the patch's cells already built (a rendered frame's
         // steady state), single thread.
-        let field = builtin_field(args.seed, 0);
+        let field = texture(0);
         let (lat, lon) = PATCH_CENTRES[0];
         let n = args.size * args.size;
         let cold = std::time::Instant::now();
@@ -142,7 +158,7 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
     }
     if let Some(out) = &args.preview {
         let (w, h) = real.as_ref().map_or((args.size, args.size), |r| (r.0, r.1));
-        let field = builtin_field(args.seed, 0);
+        let field = texture(0);
         let (lat, lon) = PATCH_CENTRES[0];
         let ours = sample_patch(&field, lat, lon, w, h, PATCH_PX_KM, REAL_QUANTUM_K);
         let gap = 8;

@@ -191,7 +191,8 @@ impl Library {
                 cloud_days
                     .iter()
                     .map(|&day| {
-                        let field = CloudField::new(&grids[&day], day as u64, file.dataset.seed);
+                        let field = CloudField::new(&grids[&day], day as u64, file.dataset.seed)
+                            .with_cloud_top_texture(file.earth_model.cloud_top_texture_k);
                         field.fill();
                         (day, Arc::new(field))
                     })

@@ -167,6 +167,13 @@ pub const MESOSCALE_OCTAVES: std::ops::Range<usize> = 3..6;
 /// (real convective scenes: spectrum slope −3.1; without it −3.4…−3.8 here), while the
 /// 2-px steps stay within the real scenes' range (it is a few K, not an edge).
 pub const CLOUD_TOP_TEXTURE_K: f64 = 3.0;
+/// Amplitude of every other cloud top's texture per σ of the finer octaves, K, unless
+/// a scene file sets it (`earth_model.cloud_top_texture_k`,
+/// [`CloudField::with_cloud_top_texture`]): 0, flat tops, the field every dataset so
+/// far was rendered with. Real 4 km imagery has grainy tops (`tirroi earth-texture
+/// --stats`, 5 × 5 σ on cloud tops: real 2.8 / 7.0 K at p50 / p90, ours 1.55 / 3.75 K
+/// at 0; docs/scenes.md § Cloud-top texture).
+pub const LOW_TOP_TEXTURE_K: f64 = 0.0;
 /// The cloud-top texture's noise is clipped at this many σ (so it stays a few K).
 pub const CLOUD_TOP_TEXTURE_CLIP: f64 = 2.0;
 /// Lattice of the cold-fragment noise, km: a value-noise peak above a high threshold
@@ -364,6 +371,9 @@ pub struct CloudField {
     small_sigma: f64,
     /// Σ a² of the coarse octaves over that of the mesoscale ones.
     coarse_over_meso_var: f64,
+    /// Texture of the tops outside deep convection, K per σ of the finer octaves
+    /// ([`LOW_TOP_TEXTURE_K`] unless set).
+    low_top_texture_k: f64,
     clear_t_k: Vec<f64>,
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
@@ -389,6 +399,7 @@ impl Clone for CloudField {
             sigma: self.sigma,
             small_sigma: self.small_sigma,
             coarse_over_meso_var: self.coarse_over_meso_var,
+            low_top_texture_k: self.low_top_texture_k,
             clear_t_k: self.clear_t_k.clone(),
             cells: self.cells.clone(),
             balance: self.balance.clone(),
@@ -484,6 +495,7 @@ impl CloudField {
             sigma: 1.0,
             small_sigma: 1.0,
             coarse_over_meso_var: 1.0,
+            low_top_texture_k: LOW_TOP_TEXTURE_K,
             clear_t_k,
             cells: (0..OlrGrid::ROWS * OlrGrid::COLS)
                 .map(|_| OnceLock::new())
@@ -535,6 +547,16 @@ impl CloudField {
             *slot = values[idx];
         }
         field
+    }
+
+    /// The field with the tops outside deep convection textured by `k` K per σ of the
+    /// finer (12 and 6 km) octaves, clipped at ±[`CLOUD_TOP_TEXTURE_CLIP`] σ (0: flat,
+    /// [`LOW_TOP_TEXTURE_K`]; NaN or negative values count as 0). Call it on a new field,
+    /// before any temperature is read: cells are built, and cached, on first use. Each
+    /// cell's flux is kept as before (the texture is in the tile the balance measures).
+    pub fn with_cloud_top_texture(mut self, k: f64) -> CloudField {
+        self.low_top_texture_k = if k.is_finite() { k.max(0.0) } else { 0.0 };
+        self
     }
 
     /// Sum of the octaves in `range` at unit vector `p`.
@@ -656,9 +678,9 @@ impl CloudField {
             (n[0] + n[1] + n[2], width)
         };
         // Deep cloud tops are not flat at the camera's scale (overshooting tops, gravity
-        // waves, anvil cirrus): the finer octaves, in their own σ, give them texture.
-        let top_texture = deep
-            * CLOUD_TOP_TEXTURE_K
+        // waves, anvil cirrus): the finer octaves, in their own σ, give them texture;
+        // the others' tops the field's own amplitude (0 by default: flat).
+        let top_texture = (deep * CLOUD_TOP_TEXTURE_K + (1.0 - deep) * self.low_top_texture_k)
             * (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
         // Cold fragments: above the threshold, a sharp-edged top 18 K colder than the
         // clear sky at the edge, 40 K at the core, whatever the cloud fraction (the

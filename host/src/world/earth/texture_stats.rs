@@ -33,6 +33,18 @@ pub const LOCAL_MEDIAN_PX: usize = 11;
 pub const SMALL_FEATURE_MAX_PX: usize = 12;
 /// Largest mid-sized cold feature, px.
 pub const MID_FEATURE_MAX_PX: usize = 60;
+/// The image's warm reference, its clear sky: the brightness temperature at this
+/// quantile of its valid pixels (p90: cloud-free surface in any scene with less than
+/// 90 % cloud cover).
+pub const WARM_QUANTILE: f64 = 0.9;
+/// A pixel is under cloud top when it is at least this much colder than the warm
+/// reference, K (the shallowest low cloud, `clouds::MIN_CLOUD_COLD_K`, is 15.5 K).
+pub const CLOUD_TOP_DEPTH_K: f64 = 10.0;
+/// Side of the windows whose spread is a cloud top's texture, px (20 km at 4 km).
+pub const CLOUD_TOP_WINDOW_PX: usize = 5;
+/// The band of intermediate levels below the warm reference, K: thin cloud, cloud
+/// fringes and mixed pixels, neither clear surface nor cloud top.
+pub const INTERMEDIATE_BAND_K: (f64, f64) = (2.0, 15.0);
 
 /// Statistics of one image (see the README's table).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +61,14 @@ pub struct TextureStats {
     /// [`COLD_FEATURE_DEPTH_K`] below their local median, small (≤
     /// [`SMALL_FEATURE_MAX_PX`] px) and mid-sized (≤ [`MID_FEATURE_MAX_PX`] px).
     pub cold_features_per_10k_px: [f64; 2],
+    /// Texture of cloud tops: the standard deviation of the brightness temperature in
+    /// the [`CLOUD_TOP_WINDOW_PX`]² windows whose pixels are all valid and at least
+    /// [`CLOUD_TOP_DEPTH_K`] below the warm reference ([`WARM_QUANTILE`]), p50 and p90,
+    /// K (NaN without such a window).
+    pub cloud_top_sd_k: [f64; 2],
+    /// Share of the valid pixels in [`INTERMEDIATE_BAND_K`] below the warm reference
+    /// (0..=1): how much of the scene lies between the clear surface and the cloud tops.
+    pub intermediate_share: f64,
     /// Number of 2-px steps measured.
     pub steps: usize,
 }
@@ -101,9 +121,50 @@ impl TextureStats {
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
             cold_features_per_10k_px: cold_features(t_k, w, h),
+            cloud_top_sd_k: cloud_top_sd(t_k, w, h, pct(&bt, WARM_QUANTILE)),
+            intermediate_share: bt
+                .iter()
+                .filter(|&&t| {
+                    let below = pct(&bt, WARM_QUANTILE) - t;
+                    (INTERMEDIATE_BAND_K.0..=INTERMEDIATE_BAND_K.1).contains(&below)
+                })
+                .count() as f64
+                / bt.len() as f64,
             steps: steps.len(),
         })
     }
+}
+
+/// p50 and p90 of the brightness temperature's standard deviation over the
+/// [`CLOUD_TOP_WINDOW_PX`]² windows (every position) of the row-major `w` × `h` image
+/// `t_k` whose pixels are all valid and at least [`CLOUD_TOP_DEPTH_K`] below `warm_k`,
+/// K; NaN for both without one (see [`TextureStats::cloud_top_sd_k`]).
+pub fn cloud_top_sd(t_k: &[f64], w: usize, h: usize, warm_k: f64) -> [f64; 2] {
+    let n = CLOUD_TOP_WINDOW_PX;
+    let top = warm_k - CLOUD_TOP_DEPTH_K;
+    let mut sds = Vec::new();
+    for y in 0..h.saturating_sub(n - 1) {
+        'window: for x in 0..w.saturating_sub(n - 1) {
+            let (mut s, mut s2) = (0.0, 0.0);
+            for yy in y..y + n {
+                for &t in &t_k[yy * w + x..yy * w + x + n] {
+                    // No data (NaN) leaves the window out too.
+                    if t.is_nan() || t > top {
+                        continue 'window;
+                    }
+                    s += t;
+                    s2 += t * t;
+                }
+            }
+            let m = (n * n) as f64;
+            sds.push((s2 / m - (s / m).powi(2)).max(0.0).sqrt());
+        }
+    }
+    if sds.is_empty() {
+        return [f64::NAN; 2];
+    }
+    sds.sort_by(f64::total_cmp);
+    [pct(&sds, 0.5), pct(&sds, 0.9)]
 }
 
 /// Small and mid-sized cold features per 10⁴ valid pixels of the row-major `w` × `h`

@@ -57,7 +57,7 @@ pub use kinds::{
 };
 pub use spec::{
     DEFAULT_TRUTH_COVERAGE, DatasetSettings, EarthModel, EarthSource, EarthTexture,
-    MAX_OFFSET_FRACTION, SceneSpec,
+    MAX_CLOUD_TOP_TEXTURE_K, MAX_OFFSET_FRACTION, SceneSpec,
 };
 
 /// A scene/dataset description: what a TOML file or a preset holds.

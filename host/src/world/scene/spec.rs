@@ -11,7 +11,12 @@ use super::kinds::{
     Illumination, Mode, MoonSpec, OneOrMany, Param, SequenceSpec, TargetModel, ThermalModel,
 };
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
+use crate::world::earth::clouds::LOW_TOP_TEXTURE_K;
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
+
+/// Largest `earth_model.cloud_top_texture_k`, K per σ: clipped at 2 σ, 20 K of
+/// texture, as much as a low cloud is deep.
+pub const MAX_CLOUD_TOP_TEXTURE_K: f64 = 10.0;
 use crate::world::spacecraft::MaterialCase;
 
 /// Where the Earth's longwave flux map comes from.
@@ -61,6 +66,12 @@ pub struct EarthModel {
     pub radius_km: f64,
     /// Sub-grid texture: "paper" (default) or "clouds".
     pub texture: EarthTexture,
+    /// With `texture = "clouds"`: texture of the cloud tops outside deep convection, K
+    /// per σ of the field's finer octaves, 0..=10 (default 0: flat tops, as every
+    /// preset renders them; ~2 gives the real 4 km image's cloud-top spread, docs/
+    /// scenes.md § Cloud-top texture). Not written by `--print-config` when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub cloud_top_texture_k: f64,
 }
 
 impl Default for EarthModel {
@@ -75,6 +86,7 @@ impl Default for EarthModel {
             eclipse_factor: ECLIPSE_FLUX_FACTOR,
             radius_km: EARTH_RADIUS_M / 1e3,
             texture: EarthTexture::Paper,
+            cloud_top_texture_k: LOW_TOP_TEXTURE_K,
         }
     }
 }
@@ -108,6 +120,18 @@ impl EarthModel {
             return Err(format!(
                 "earth_model.radius_km = {}: expected a number > 0",
                 self.radius_km
+            ));
+        }
+        if !(0.0..=MAX_CLOUD_TOP_TEXTURE_K).contains(&self.cloud_top_texture_k) {
+            return Err(format!(
+                "earth_model.cloud_top_texture_k = {}: expected 0..={MAX_CLOUD_TOP_TEXTURE_K} K",
+                self.cloud_top_texture_k
+            ));
+        }
+        if self.cloud_top_texture_k > 0.0 && self.texture != EarthTexture::Clouds {
+            return Err(format!(
+                "earth_model.cloud_top_texture_k = {}: only the cloud texture has cloud tops (set texture = \"clouds\")",
+                self.cloud_top_texture_k
             ));
         }
         Ok(())

@@ -104,6 +104,25 @@ fn errors_name_line_and_field() {
         .is_ok()
     );
     assert!(SceneFile::parse("", "x").is_err());
+    // Cloud-top texture: only on the cloud texture, within 0..=10 K per σ.
+    let earth = |fields: &str| format!("[earth_model]\n{fields}\n[[scene]]\nrange_m = 20.0\n");
+    let e = SceneFile::parse(&earth("cloud_top_texture_k = 2.0"), "x").unwrap_err();
+    assert!(e.to_string().contains("texture = \"clouds\""), "{e}");
+    let e = SceneFile::parse(
+        &earth("texture = \"clouds\"\ncloud_top_texture_k = -1.0"),
+        "x",
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("earth_model.cloud_top_texture_k"),
+        "{e}"
+    );
+    let f = SceneFile::parse(
+        &earth("texture = \"clouds\"\ncloud_top_texture_k = 2.0"),
+        "x",
+    )
+    .unwrap();
+    assert_eq!(f.earth_model.cloud_top_texture_k, 2.0);
 }
 
 #[test]
