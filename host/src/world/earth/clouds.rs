@@ -347,6 +347,9 @@ struct Point {
     deep: f64,
     /// Cloud-top texture of a deep-convective cloud, K (added to its depth).
     top_texture: f64,
+    /// Texture of the other clouds' tops, K ([`CloudField::with_cloud_top_texture`]; 0 by
+    /// default), faded in from the cloud's edge as the core deepens.
+    low_texture: f64,
     /// Cover of a cold fragment, 0…1 (0 almost everywhere).
     fragment: f64,
     /// Temperature of the fragment's top, K (where `fragment` > 0).
@@ -678,10 +681,12 @@ impl CloudField {
             (n[0] + n[1] + n[2], width)
         };
         // Deep cloud tops are not flat at the camera's scale (overshooting tops, gravity
-        // waves, anvil cirrus): the finer octaves, in their own σ, give them texture;
-        // the others' tops the field's own amplitude (0 by default: flat).
-        let top_texture = (deep * CLOUD_TOP_TEXTURE_K + (1.0 - deep) * self.low_top_texture_k)
-            * (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
+        // waves, anvil cirrus): the finer octaves, in their own σ, give them texture.
+        let clip = |v: f64| v.clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
+        let top_texture = deep * CLOUD_TOP_TEXTURE_K * clip(n_small / self.small_sigma);
+        // The other tops: the field's own amplitude (0 by default, flat), faded in from
+        // the cloud's edge where it is used (the edges keep their steps).
+        let low_texture = (1.0 - deep) * self.low_top_texture_k * clip(n_small / self.small_sigma);
         // Cold fragments: above the threshold, a sharp-edged top 18 K colder than the
         // clear sky at the edge, 40 K at the core, whatever the cloud fraction (the
         // real mild scene has them over clear sea and trade cumulus alike).
@@ -702,6 +707,7 @@ impl CloudField {
             width,
             deep,
             top_texture,
+            low_texture,
             fragment,
             fragment_top_k,
         }
@@ -1069,7 +1075,9 @@ impl CloudField {
         // Tops deeper than EDGE_WIDTH_FULL_DEPTH_K: the edge steps as a cloud that deep,
         // the rest of the depth comes inside (cold cores of the convective clusters).
         let edge_dt = p.dt.min(EDGE_WIDTH_FULL_DEPTH_K);
-        let cold = m * (edge_dt * depth + p.top_texture);
+        // The other tops' texture grows in with the core, so a cloud's edge steps as a
+        // flat one does.
+        let cold = m * (edge_dt * depth + p.top_texture + core * p.low_texture);
         let cold = if p.dt > edge_dt {
             cold + smoothstep(x / (DEEP_CORE_WIDTHS * p.width)) * (p.dt - edge_dt)
         } else {
