@@ -340,6 +340,29 @@ pub const WHITE_RADOME: Material = Material {
     core_conductance_w_m2_k: 0.0,
 };
 
+/// A bus's two parts, parts 0 and 1 of `b`: `"bus-radiator"` ([`WHITE_PAINT`], its
+/// radiator walls of `radiator_area_m2`) and `"bus-mli"` ([`MLI_KAPTON`], the rest,
+/// `mli_area_m2`), the internal `dissipation_w` split between them by area.
+fn bus_parts(
+    b: &mut MeshBuilder,
+    dissipation_w: f64,
+    radiator_area_m2: f64,
+    mli_area_m2: f64,
+) -> (u16, u16) {
+    let share = dissipation_w / (radiator_area_m2 + mli_area_m2);
+    let radiator = b.part(Part {
+        name: "bus-radiator",
+        material: WHITE_PAINT,
+        dissipation_w: share * radiator_area_m2,
+    });
+    let mli = b.part(Part {
+        name: "bus-mli",
+        material: MLI_KAPTON,
+        dissipation_w: share * mli_area_m2,
+    });
+    (radiator, mli)
+}
+
 /// Bus size of [`tango`] (x, y, z), m: 570 × 740 × 295 mm envelope.
 pub const TANGO_BUS_M: Vec3 = [0.74, 0.57, 0.295];
 /// Solar panel size of [`tango`] (x, y, thickness), m (estimate, see module docs).
@@ -368,22 +391,13 @@ pub fn tango(resolution_m: f64) -> Mesh {
     let (hx, hy) = (bx / 2.0, by / 2.0);
     let (phx, phy) = (px / 2.0, py / 2.0);
 
-    // Bus dissipation split by the area of the two bus parts.
-    let radiator_area = 2.0 * bx * bz;
-    let mli_area = 2.0 * by * bz + bx * by;
-    let share = TANGO_DISSIPATION_W / (radiator_area + mli_area);
-
     let mut b = MeshBuilder::new();
-    let radiator = b.part(Part {
-        name: "bus-radiator",
-        material: WHITE_PAINT,
-        dissipation_w: share * radiator_area,
-    });
-    let mli = b.part(Part {
-        name: "bus-mli",
-        material: MLI_KAPTON,
-        dissipation_w: share * mli_area,
-    });
+    let (radiator, mli) = bus_parts(
+        &mut b,
+        TANGO_DISSIPATION_W,
+        2.0 * bx * bz,
+        2.0 * by * bz + bx * by,
+    );
     let cells = b.part(Part {
         name: "solar-cells",
         material: SOLAR_CELLS,
@@ -540,21 +554,13 @@ pub fn winged_sat(resolution_m: f64) -> Mesh {
     let z_top = z0 + bz;
     let z_mid = z0 + bz / 2.0;
 
-    let radiator_area = 2.0 * by * bz;
-    let mli_area = 2.0 * bx * bz + 2.0 * bx * by;
-    let share = WINGED_DISSIPATION_W / (radiator_area + mli_area);
-
     let mut b = MeshBuilder::new();
-    let radiator = b.part(Part {
-        name: "bus-radiator",
-        material: WHITE_PAINT,
-        dissipation_w: share * radiator_area,
-    });
-    let mli = b.part(Part {
-        name: "bus-mli",
-        material: MLI_KAPTON,
-        dissipation_w: share * mli_area,
-    });
+    let (radiator, mli) = bus_parts(
+        &mut b,
+        WINGED_DISSIPATION_W,
+        2.0 * by * bz,
+        2.0 * bx * bz + 2.0 * bx * by,
+    );
     // The wings' faces conduct through their honeycomb core (Tango's body-mounted panel
     // is modelled without it, as in the paper's case study).
     let cells = b.part(Part {
