@@ -682,11 +682,12 @@ impl CloudField {
         };
         // Deep cloud tops are not flat at the camera's scale (overshooting tops, gravity
         // waves, anvil cirrus): the finer octaves, in their own σ, give them texture.
-        let clip = |v: f64| v.clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
-        let top_texture = deep * CLOUD_TOP_TEXTURE_K * clip(n_small / self.small_sigma);
+        let texture =
+            (n_small / self.small_sigma).clamp(-CLOUD_TOP_TEXTURE_CLIP, CLOUD_TOP_TEXTURE_CLIP);
+        let top_texture = deep * CLOUD_TOP_TEXTURE_K * texture;
         // The other tops: the field's own amplitude (0 by default, flat), faded in from
         // the cloud's edge where it is used (the edges keep their steps).
-        let low_texture = (1.0 - deep) * self.low_top_texture_k * clip(n_small / self.small_sigma);
+        let low_texture = (1.0 - deep) * self.low_top_texture_k * texture;
         // Cold fragments: above the threshold, a sharp-edged top 18 K colder than the
         // clear sky at the edge, 40 K at the core, whatever the cloud fraction (the
         // real mild scene has them over clear sea and trade cumulus alike).

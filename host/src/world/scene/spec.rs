@@ -13,11 +13,11 @@ use super::kinds::{
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
 use crate::world::earth::clouds::LOW_TOP_TEXTURE_K;
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
+use crate::world::spacecraft::MaterialCase;
 
 /// Largest `earth_model.cloud_top_texture_k`, K per σ: clipped at 2 σ, 20 K of
 /// texture, as much as a low cloud is deep.
 pub const MAX_CLOUD_TOP_TEXTURE_K: f64 = 10.0;
-use crate::world::spacecraft::MaterialCase;
 
 /// Where the Earth's longwave flux map comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
