@@ -110,6 +110,8 @@ impl TextureStats {
             |lim: f64| steps.iter().filter(|&&s| s > lim).count() as f64 / steps.len() as f64;
         let mut bt: Vec<f64> = t_k.iter().copied().filter(|v| v.is_finite()).collect();
         bt.sort_by(f64::total_cmp);
+        // The clear surface: the reference of the cloud-top statistics.
+        let warm_k = pct(&bt, WARM_QUANTILE);
         Some(TextureStats {
             step2_k: [
                 pct(&steps, 0.5),
@@ -121,12 +123,11 @@ impl TextureStats {
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
             cold_features_per_10k_px: cold_features(t_k, w, h),
-            cloud_top_sd_k: cloud_top_sd(t_k, w, h, pct(&bt, WARM_QUANTILE)),
+            cloud_top_sd_k: cloud_top_sd(t_k, w, h, warm_k),
             intermediate_share: bt
                 .iter()
                 .filter(|&&t| {
-                    let below = pct(&bt, WARM_QUANTILE) - t;
-                    (INTERMEDIATE_BAND_K.0..=INTERMEDIATE_BAND_K.1).contains(&below)
+                    (INTERMEDIATE_BAND_K.0..=INTERMEDIATE_BAND_K.1).contains(&(warm_k - t))
                 })
                 .count() as f64
                 / bt.len() as f64,
