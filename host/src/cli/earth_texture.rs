@@ -35,7 +35,8 @@ pub struct EarthTextureArgs {
     #[arg(long, default_value_t = 512)]
     pub size: usize,
     /// Texture of the cloud tops outside deep convection, K per σ of the finer octaves
-    /// (a scene file's `earth_model.cloud_top_texture_k`), 0..=10.
+    /// (a scene file's `earth_model.cloud_top_texture_k`; the `realistic` presets render
+    /// 5), 0..=10.
     #[arg(long, default_value_t = 0.0)]
     pub cloud_top_texture_k: f64,
 }

@@ -169,8 +169,8 @@ pub const MESOSCALE_OCTAVES: std::ops::Range<usize> = 3..6;
 pub const CLOUD_TOP_TEXTURE_K: f64 = 3.0;
 /// Amplitude of every other cloud top's texture per σ of the finer octaves, K, unless
 /// a scene file sets it (`earth_model.cloud_top_texture_k`,
-/// [`CloudField::with_cloud_top_texture`]): 0, flat tops, the field every dataset so
-/// far was rendered with. Real 4 km imagery has grainy tops (`tirroi earth-texture
+/// [`CloudField::with_cloud_top_texture`]): 0, flat tops (the `realistic` presets set
+/// 5 since session 45; the other scene files and `tirroi earth-texture` keep 0). Real 4 km imagery has grainy tops (`tirroi earth-texture
 /// --stats`, 5 × 5 σ on cloud tops: real 2.8 / 7.0 K at p50 / p90, ours 1.55 / 3.75 K
 /// at 0; docs/scenes.md § Cloud-top texture).
 pub const LOW_TOP_TEXTURE_K: f64 = 0.0;

@@ -67,10 +67,9 @@ pub struct EarthModel {
     /// Sub-grid texture: "paper" (default) or "clouds".
     pub texture: EarthTexture,
     /// With `texture = "clouds"`: texture of the cloud tops outside deep convection, K
-    /// per σ of the field's finer octaves, 0..=10 (default 0: flat tops, as every
-    /// preset renders them; ~5 gives about the real 4 km image's median cloud-top
-    /// spread, docs/scenes.md § Cloud-top texture). Not written by `--print-config`
-    /// when 0.
+    /// per σ of the field's finer octaves, 0..=10 (default 0: flat tops; the `realistic`
+    /// presets set 5, about the real 4 km image's median cloud-top spread,
+    /// docs/scenes.md § Cloud-top texture). Not written by `--print-config` when 0.
     #[serde(skip_serializing_if = "is_zero")]
     pub cloud_top_texture_k: f64,
 }
