@@ -31,6 +31,7 @@ pub mod features;
 pub mod forest;
 mod forest_trees;
 pub mod half_max;
+pub mod limb;
 pub mod look;
 pub mod narrow;
 pub mod order;
@@ -1362,6 +1363,11 @@ impl AutoV2 {
             score_permille,
             false,
         );
+        // Stage 4d (session 45): a box that is the Earth's limb at the frame's border is
+        // no target, nor a tracker's candidate (stage 5e's spots may still answer).
+        if d.roi.is_some_and(|r| limb::is_limb(frame, r)) {
+            return NO_TARGET;
+        }
         if below_gate {
             // A tracker's candidate: kept, and the call goes on as without a box.
             work.candidate = d.roi.map(|r| (r, score_permille));

@@ -1,0 +1,307 @@
+//! The Earth's limb at the frame's border (session 45). Over deep space the Earth's
+//! disc, cut by the frame, shows as a bright triangle in a corner or a sliver along a
+//! side; the classifier's winner there was most of family A's no-target false alarms
+//! (11 of 17 of famAE's). Its in-frame boundary is one arc of the disc (at the
+//! camera's ~10 900 km from the Earth's centre its angular radius is ~36°, ~700 px, so
+//! the arc is nearly straight over a frame), while a spacecraft cut by the frame shows
+//! corners. A spacecraft's single straight edge at the border would look the same, so
+//! the test stays narrow: a box on the frame's border, at most a quarter of the frame,
+//! hardly saturated (a saturated target's face cut by the frame is straight too,
+//! family A's detection frames), whose boundary between its two levels (Otsu inside
+//! the box) follows a parabola within [`MAX_ARC_RMS2_PX2`].
+
+use crate::frame::Frame;
+use crate::roi::Roi;
+
+/// Histogram bins of the box's Otsu threshold (between its lowest and highest DN).
+const OTSU_BINS: usize = 256;
+
+/// Largest box tested, as a share of the frame (1/4): the limb pieces that won on
+/// family A were slivers of 30–100 px; a larger box is left to the confidence (and the
+/// test's cost, 3 reads of each of its pixels, stays under a quarter frame).
+const MAX_FRAME_SHARE_DIVISOR: usize = 4;
+
+/// A box with at least 1/10 of its pixels at the top DN is a saturated target's face
+/// (family A: saturated detection targets cut by the frame have straight edges too,
+/// their boxes 39–97 % saturated; the limb's were 0–1 %).
+const SATURATED_SHARE_DIVISOR: u32 = 10;
+
+/// Fewest boundary pixels for a fit: fewer is a speck, not an arc.
+const MIN_BOUNDARY_PX: u32 = 8;
+
+/// Largest mean squared distance, px², of the boundary pixels from the fitted
+/// parabola for an arc: 1.7² (family A, session 45: the limb's boundaries 1.2–1.6 px
+/// rms, as a 4-connected staircase of a slanted line is about 1 px thick; two edges
+/// meeting at a corner depart further).
+pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
+
+/// Whether `roi` is a piece of the Earth's limb at the frame's border (see the module
+/// docs): `false` for a box not on the border, over a quarter of the frame, under
+/// 3 px on a side, at least a tenth saturated, with fewer than [`MIN_BOUNDARY_PX`]
+/// boundary pixels, or whose boundary is not an arc. Reads the box's pixels three
+/// times; 1 KiB of stack (the histogram).
+pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
+    let (w, h) = (frame.width(), frame.height());
+    let (x0, y0, x1, y1) = (
+        usize::from(roi.x0),
+        usize::from(roi.y0),
+        usize::from(roi.x1),
+        usize::from(roi.y1),
+    );
+    if x1 > w || y1 > h || x1 < x0 + 3 || y1 < y0 + 3 {
+        return false;
+    }
+    let on_border = [x0 == 0, y0 == 0, x1 == w, y1 == h];
+    let area = (x1 - x0) * (y1 - y0);
+    if !on_border.contains(&true) || area * MAX_FRAME_SHARE_DIVISOR > w * h {
+        return false;
+    }
+    let rows = || (y0..y1).filter_map(|y| frame.row(y).and_then(|r| r.get(x0..x1)));
+    // Pass 1: the box's range and its saturated pixels.
+    let top = frame.max_dn();
+    let (mut lo, mut hi, mut saturated) = (u16::MAX, 0u16, 0u32);
+    for row in rows() {
+        for &v in row {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            saturated += u32::from(v >= top);
+        }
+    }
+    if hi <= lo || saturated * SATURATED_SHARE_DIVISOR >= area as u32 {
+        return false;
+    }
+    // Pass 2: Otsu's threshold on a histogram of the box.
+    let span = u32::from(hi - lo) + 1;
+    let bin = |v: u16| (u32::from(v - lo) * OTSU_BINS as u32 / span) as usize;
+    let mut hist = [0u32; OTSU_BINS];
+    for row in rows() {
+        for &v in row {
+            if let Some(c) = hist.get_mut(bin(v)) {
+                *c += 1;
+            }
+        }
+    }
+    let Some(t_bin) = otsu_bin(&hist) else {
+        return false;
+    };
+    let above = |v: u16| bin(v) > t_bin;
+    // The region is the level the border sides of the box mostly show.
+    let mut border = [0u32; 2];
+    let mut count = |v: u16| border[usize::from(above(v))] += 1;
+    for (y, row) in (y0..y1).zip(rows()) {
+        if on_border[0] {
+            row.first().copied().map(&mut count);
+        }
+        if on_border[2] {
+            row.last().copied().map(&mut count);
+        }
+        if (on_border[1] && y == y0) || (on_border[3] && y == y1 - 1) {
+            row.iter().copied().for_each(&mut count);
+        }
+    }
+    let region_above = border[1] >= border[0];
+    let inside = |v: u16| above(v) == region_above;
+    // Pass 3: the boundary pixels (in the region, a 4-neighbour in the box not) and
+    // the sums of two parabola fits, y on x and x on y (coordinates from the box's
+    // centre, doubled to stay integers).
+    let (cx2, cy2) = ((x0 + x1) as i64, (y0 + y1) as i64);
+    let mut fit_x = ParabolaSums::default();
+    let mut fit_y = ParabolaSums::default();
+    let mut prev: Option<&[u16]> = None;
+    let mut it = rows().peekable();
+    let mut y = y0;
+    while let Some(row) = it.next() {
+        let next = it.peek().copied();
+        for (i, &v) in row.iter().enumerate() {
+            if !inside(v) {
+                continue;
+            }
+            let out = |r: Option<&[u16]>, k: Option<usize>| {
+                k.and_then(|k| r.and_then(|r| r.get(k)))
+                    .is_some_and(|&q| !inside(q))
+            };
+            let boundary = out(Some(row), i.checked_sub(1))
+                || out(Some(row), Some(i + 1))
+                || out(prev, Some(i))
+                || out(next, Some(i));
+            if boundary {
+                let (u, v) = (2 * (x0 + i) as i64 + 1 - cx2, 2 * y as i64 + 1 - cy2);
+                fit_x.add(u as f64 / 2.0, v as f64 / 2.0);
+                fit_y.add(v as f64 / 2.0, u as f64 / 2.0);
+            }
+        }
+        prev = Some(row);
+        y += 1;
+    }
+    if fit_x.n < f64::from(MIN_BOUNDARY_PX) {
+        return false;
+    }
+    let rms2 = fit_x.residual2().min(fit_y.residual2());
+    rms2 <= MAX_ARC_RMS2_PX2
+}
+
+/// The bin of Otsu's threshold (the last bin of the lower class) over `hist`; `None`
+/// with one occupied bin.
+fn otsu_bin(hist: &[u32; OTSU_BINS]) -> Option<usize> {
+    let total: f64 = hist.iter().map(|&c| f64::from(c)).sum();
+    let sum: f64 = hist
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| i as f64 * f64::from(c))
+        .sum();
+    let (mut w0, mut m0) = (0.0f64, 0.0f64);
+    let mut best: Option<(usize, f64)> = None;
+    for (i, &c) in hist.iter().enumerate() {
+        w0 += f64::from(c);
+        m0 += i as f64 * f64::from(c);
+        let w1 = total - w0;
+        if w0 == 0.0 || w1 == 0.0 {
+            continue;
+        }
+        let d = sum * w0 - m0 * total;
+        let between = d * d / (w0 * w1);
+        if best.is_none_or(|(_, b)| between > b) {
+            best = Some((i, between));
+        }
+    }
+    best.map(|(i, _)| i)
+}
+
+/// Sums of the least-squares parabola `v = a + b·u + c·u²` over points `(u, v)`.
+#[derive(Default, Clone, Copy)]
+struct ParabolaSums {
+    n: f64,
+    u: f64,
+    u2: f64,
+    u3: f64,
+    u4: f64,
+    v: f64,
+    uv: f64,
+    u2v: f64,
+    v2: f64,
+}
+
+impl ParabolaSums {
+    fn add(&mut self, u: f64, v: f64) {
+        let u2 = u * u;
+        self.n += 1.0;
+        self.u += u;
+        self.u2 += u2;
+        self.u3 += u2 * u;
+        self.u4 += u2 * u2;
+        self.v += v;
+        self.uv += u * v;
+        self.u2v += u2 * v;
+        self.v2 += v * v;
+    }
+
+    /// The mean squared distance of the points from the best parabola, px², across
+    /// it (∞ when `u` takes fewer than three values: no parabola of `v` on `u`).
+    fn residual2(&self) -> f64 {
+        let m = [
+            [self.n, self.u, self.u2],
+            [self.u, self.u2, self.u3],
+            [self.u2, self.u3, self.u4],
+        ];
+        let b = [self.v, self.uv, self.u2v];
+        let det = det3(&m);
+        if det.is_nan() || det.abs() <= 1e-9 * self.n.max(1.0) {
+            return f64::INFINITY;
+        }
+        // Cramer's rule: each coefficient from `m` with one column replaced by `b`.
+        let coef = |k: usize| {
+            let mut mk = m;
+            for (row, &bi) in mk.iter_mut().zip(b.iter()) {
+                if let Some(c) = row.get_mut(k) {
+                    *c = bi;
+                }
+            }
+            det3(&mk) / det
+        };
+        let (a, b1, c) = (coef(0), coef(1), coef(2));
+        let rss = self.v2 - (a * self.v + b1 * self.uv + c * self.u2v);
+        // From distances along `v` to distances across the curve (its slope at the
+        // box's centre): a slanted line's points lie √(1 + b²) farther along `v`.
+        rss.max(0.0) / self.n / (1.0 + b1 * b1)
+    }
+}
+
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    let [[a, b, c], [d, e, f], [g, h, i]] = *m;
+    a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const W: usize = 160;
+    const H: usize = 120;
+
+    /// A 14-bit frame: 1 000 DN deep space, 6 000 DN where `bright(x, y)`.
+    fn frame_of(bright: impl Fn(f64, f64) -> bool) -> [u16; W * H] {
+        let mut px = [1000u16; W * H];
+        for y in 0..H {
+            for x in 0..W {
+                if bright(x as f64 + 0.5, y as f64 + 0.5) {
+                    px[y * W + x] = 6000;
+                }
+            }
+        }
+        px
+    }
+
+    fn roi(x0: u16, y0: u16, x1: u16, y1: u16) -> Roi {
+        Roi { x0, y0, x1, y1 }
+    }
+
+    #[test]
+    fn a_disc_in_the_corner_is_the_limb() {
+        // A disc of 700 px radius whose edge cuts the top-right corner.
+        let (cx, cy, r) = (160.0 + 480.0, -480.0, 700.0);
+        let px = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        assert!(is_limb(&f, roi(100, 0, 160, 50)));
+    }
+
+    #[test]
+    fn a_limb_along_one_side_is_the_limb() {
+        // The disc's edge runs down the left side, 5–25 px in.
+        let (cx, cy, r) = (-700.0 + 15.0, 60.0, 700.0);
+        let px = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        assert!(is_limb(&f, roi(0, 0, 30, 120)));
+    }
+
+    #[test]
+    fn a_cube_corner_at_the_border_is_not() {
+        // A square's corner (two edges at 90°) with one side on the frame's edge.
+        let px = frame_of(|x, y| x > 110.0 && y < 40.0);
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        // Box of the square plus margin: its boundary is an L.
+        let sq = frame_of(|x, y| (100.0..140.0).contains(&x) && y < 40.0);
+        let g = Frame::new(&sq, W, H, 14).unwrap();
+        assert!(!is_limb(&g, roi(90, 0, 150, 50)));
+        // Sanity: the half-plane (one straight edge) is an arc.
+        assert!(is_limb(&f, roi(100, 0, 160, 40)));
+    }
+
+    #[test]
+    fn boxes_off_the_border_too_large_or_saturated_are_not() {
+        let (cx, cy, r) = (160.0 + 480.0, -480.0, 700.0);
+        let px = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        assert!(!is_limb(&f, roi(100, 1, 159, 50)), "off the border");
+        assert!(!is_limb(&f, roi(0, 0, 160, 120)), "the whole frame");
+        let mut sat = px;
+        for v in sat.iter_mut().filter(|v| **v == 6000) {
+            *v = 16383;
+        }
+        let s = Frame::new(&sat, W, H, 14).unwrap();
+        assert!(!is_limb(&s, roi(100, 0, 160, 50)), "saturated");
+        // Flat: one level, no threshold.
+        let flat = [1000u16; W * H];
+        let g = Frame::new(&flat, W, H, 14).unwrap();
+        assert!(!is_limb(&g, roi(100, 0, 160, 50)));
+    }
+}
