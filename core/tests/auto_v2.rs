@@ -10,7 +10,9 @@
 //! through the registry
 //! (`Method::AutoV2`) it answers as called directly; the sequence tracker
 //! (`roi::track::Tracker`) keeps the same invariants over three frames and answers the
-//! same after a reset. Parameters out of bounds are an error, never a panic.
+//! same after a reset. Parameters out of bounds are an error, never a panic. Stage 4d's
+//! limb test answers any box of any frame the same twice, `true` only for a box on the
+//! frame's border, inside it and at most a quarter of it.
 //!
 //! Runs are deterministic (a fixed seed) unless `PROPTEST_RNG_SEED` says otherwise.
 //! Debug builds run `auto-v2` at some 10–20 ms per full frame: the case counts keep
@@ -523,5 +525,37 @@ proptest! {
             frame(seed, w, h, bits)
         };
         check_tracker(&img, det, step)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(64))]
+
+    /// Stage 4d's limb test (`learned::limb::is_limb`) on any frame and any box, inside
+    /// the frame or not: no panic, the same answer twice, and `false` for a box off the
+    /// frame's border, over a quarter of the frame or reaching beyond it.
+    #[test]
+    fn limb_test_answers_for_any_box(
+        seed in any::<u64>(),
+        w in 8usize..=FRAME_WIDTH,
+        h in 8usize..=FRAME_HEIGHT,
+        bits in 1u8..=16,
+        corners in (0u16..400, 0u16..300, 0u16..400, 0u16..300),
+    ) {
+        use tirroi_core::roi::auto::learned::limb::is_limb;
+        let img = frame(seed, w, h, bits);
+        let f = img.frame();
+        let (a, b, c, d) = corners;
+        let r = Roi { x0: a.min(c), y0: b.min(d), x1: a.max(c), y1: b.max(d) };
+        let answer = is_limb(&f, r);
+        prop_assert_eq!(answer, is_limb(&f, r));
+        let (x0, y0, x1, y1) =
+            (usize::from(r.x0), usize::from(r.y0), usize::from(r.x1), usize::from(r.y1));
+        let on_border = x0 == 0 || y0 == 0 || x1 == w || y1 == h;
+        let inside = x1 <= w && y1 <= h;
+        let small = (x1 - x0) * (y1 - y0) * 4 <= w * h;
+        if answer {
+            prop_assert!(on_border && inside && small, "{r:?} in {w}x{h}");
+        }
     }
 }
