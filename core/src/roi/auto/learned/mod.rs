@@ -1363,14 +1363,16 @@ impl AutoV2 {
             score_permille,
             false,
         );
-        // Stage 4d (session 45): a box that is the Earth's limb at the frame's border is
-        // no target, nor a tracker's candidate (stage 5e's spots may still answer).
-        if d.roi.is_some_and(|r| limb::is_limb(frame, r)) {
-            return NO_TARGET;
-        }
         if below_gate {
             // A tracker's candidate: kept, and the call goes on as without a box.
             work.candidate = d.roi.map(|r| (r, score_permille));
+            return NO_TARGET;
+        }
+        // Stage 4d (session 45): a box that is the Earth's limb at the frame's border is
+        // no target (stage 5e's spots may still answer). A candidate under the gate stays
+        // one: a target entering the frame shows one straight edge too, and the sequence
+        // tracker confirms a candidate by its motion against the ground.
+        if d.roi.is_some_and(|r| limb::is_limb(frame, r)) {
             return NO_TARGET;
         }
         d
