@@ -500,7 +500,8 @@ impl<C: FrameCapacity> AutoV2Work<C> {
         )
     }
 
-    /// What the region stage chose on the last frame.
+    /// What the region stage chose on the last frame (`None` when stage 4d found its
+    /// box to be the Earth's limb at the frame's border).
     pub fn winner(&self) -> Option<Winner> {
         self.winner
     }
@@ -1373,6 +1374,7 @@ impl AutoV2 {
         // one: a target entering the frame shows one straight edge too, and the sequence
         // tracker confirms a candidate by its motion against the ground.
         if d.roi.is_some_and(|r| limb::is_limb(frame, r)) {
+            work.winner = None;
             return NO_TARGET;
         }
         d
