@@ -18,7 +18,7 @@ const OTSU_BINS: usize = 256;
 
 /// Largest box tested, as a share of the frame (1/4): the limb pieces that won on
 /// family A were slivers of 30–100 px; a larger box is left to the confidence (and the
-/// test's cost, 3 reads of each of its pixels, stays under a quarter frame).
+/// test's cost, about 8 reads of each of its pixels, stays under a quarter frame).
 const MAX_FRAME_SHARE_DIVISOR: usize = 4;
 
 /// A box with at least 1/10 of its pixels at the top DN is a saturated target's face
@@ -38,8 +38,9 @@ pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 /// Whether `roi` is a piece of the Earth's limb at the frame's border (see the module
 /// docs): `false` for a box not on the border, over a quarter of the frame, under
 /// 3 px on a side, at least a tenth saturated, with fewer than [`MIN_BOUNDARY_PX`]
-/// boundary pixels, or whose boundary is not an arc. Reads the box's pixels three
-/// times; 1 KiB of stack (the histogram).
+/// boundary pixels, or whose boundary is not an arc. Four passes over the box (about
+/// 8 pixel reads per pixel: range, histogram, region, and each region pixel's four
+/// neighbours); 1 KiB of stack (the histogram).
 pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
     let (w, h) = (frame.width(), frame.height());
     let (x0, y0, x1, y1) = (
