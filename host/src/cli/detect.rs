@@ -27,8 +27,8 @@ pub struct DetectArgs {
     /// Print one JSON object per frame and method.
     #[arg(long)]
     pub json: bool,
-    /// Bit depth of the DN, 1..=16 (default: 8 for 8-bit files; 14 for 16-bit files whose
-    /// DN fit, else 16).
+    /// Bit depth of the DN, 1..=16 (default: 8 for 8-bit files; a 16-bit PNG's `sBIT`
+    /// depth, which tirroi's renders write; else 14 for 16-bit files whose DN fit, else 16).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
     /// Mask-to-box rule for every detector: largest-component or all-foreground

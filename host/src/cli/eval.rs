@@ -55,7 +55,8 @@ pub struct EvalArgs {
     /// Mask-to-box rule: largest-component or all-foreground.
     #[arg(long, default_value = "largest-component", value_parser = parse_box_rule)]
     pub box_rule: BoxRule,
-    /// Bit depth of the DN, 1..=16 (default: 14 for 16-bit files whose DN fit).
+    /// Bit depth of the DN, 1..=16, for frames whose `truth.csv` row has none (default: a
+    /// 16-bit PNG's `sBIT` depth, else 14 for 16-bit files whose DN fit).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
     /// Write scores.csv, summary.csv and summary.json here.

@@ -28,7 +28,8 @@ pub struct TuneArgs {
     /// Repeat it: different keys must all match, values of one key are alternatives.
     #[arg(long = "where", value_name = "KEY=VALUE", value_parser = parse_where)]
     pub wheres: Vec<Where>,
-    /// Bit depth of the DN, 1..=16 (default: 14 for 16-bit files whose DN fit).
+    /// Bit depth of the DN, 1..=16 (default: a 16-bit PNG's `sBIT` depth, else 14 for
+    /// 16-bit files whose DN fit).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub bits: Option<u8>,
     /// Most refinement moves per method after the grid, 0..=100 (0: grid only).

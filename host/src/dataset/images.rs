@@ -259,13 +259,8 @@ pub(super) fn write_image(
     let rec = record(file, plan, frame, thermal);
     let (w, h) = (frame.width as u32, frame.height as u32);
     let path = dir.join(&rec.file);
-    let png = encode_png(
-        &image_io::native_bytes(&frame.dn),
-        w,
-        h,
-        image::ExtendedColorType::L16,
-        &path,
-    )?;
+    let png = image_io::encode_dn_png(&frame.dn, w, h, frame.mapping.bits())
+        .map_err(|e| DatasetError(format!("{}: cannot encode PNG: {e}", path.display())))?;
     atomic_write(&path, &png)?;
     if options.masks {
         let mask: Vec<u8> = frame

@@ -513,7 +513,7 @@ pub struct EvalOptions {
     /// `make_bank` (e.g. tuned per method).
     pub box_rule: Option<BoxRule>,
     /// Bit depth of the frames without a `bits` column in `truth.csv` (None: from the
-    /// file, 14 for 16-bit files that fit); a row's own `bits` wins.
+    /// file: a 16-bit PNG's `sBIT`, else 14 for 16-bit files that fit); a row's own `bits` wins.
     pub bits: Option<u8>,
     /// Where `auto` gets its tracking prior (the other methods have none).
     pub track: Track,

@@ -119,8 +119,10 @@ pub fn parse_box_px<T: std::str::FromStr + PartialOrd + Copy>(s: &str) -> Result
 /// How to read a frame file ([`read_frame_with`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ReadOptions {
-    /// Bit depth of the DN (`--bits`); `None`: 8 for 8-bit files, 14 for 16-bit files
-    /// whose DN fit (else 16), 14 for FITS.
+    /// Bit depth of the DN (`--bits`); `None`: 8 for 8-bit files; for 16-bit PNG the
+    /// depth its `sBIT` chunk states (tirroi's renders write it, [`encode_dn_png`]) when
+    /// every DN fits it; otherwise 14 for 16-bit files whose DN fit (else 16), and 14
+    /// for FITS.
     pub bits: Option<u8>,
     /// FITS only: DN added to the physical value before rounding (`--fits-offset`);
     /// `None`: [`default_fits_offset_dn`].
@@ -199,8 +201,9 @@ impl std::error::Error for FrameFileError {}
 
 /// Reads an 8- or 16-bit grayscale PNG (or TIFF, or FITS) as DN.
 ///
-/// The bit depth is `bits` when given; otherwise 8 for 8-bit files, and for 16-bit
-/// files the project's default of 14 bits when every DN fits, else 16. Warnings
+/// The bit depth is `bits` when given; otherwise 8 for 8-bit files, a 16-bit PNG's
+/// `sBIT` depth when every DN fits it, and for other 16-bit files the project's default
+/// of 14 bits when every DN fits, else 16 ([`ReadOptions::bits`]). Warnings
 /// ([`read_frame_with`]) are dropped.
 ///
 /// # Errors
@@ -391,10 +394,20 @@ pub fn read_frame_with(
             }
             None if file_bits == 8 => 8,
             None => {
-                if max < 1 << tirroi_core::frame::DEFAULT_BIT_DEPTH {
+                let guess = if max < 1 << tirroi_core::frame::DEFAULT_BIT_DEPTH {
                     tirroi_core::frame::DEFAULT_BIT_DEPTH
                 } else {
                     16
+                };
+                match png_significant_bits(path) {
+                    Some(s) if s >= 16 || u32::from(max) < 1u32 << s => s,
+                    Some(s) => {
+                        warnings.push(format!(
+                            "the PNG's sBIT chunk says {s} bits, but a DN of {max} needs more: read at {guess} bits (see --bits)"
+                        ));
+                        guess
+                    }
+                    None => guess,
                 }
             }
         };
@@ -460,7 +473,65 @@ pub fn encode_png(
     Ok(out)
 }
 
-/// Writes DN as a 16-bit grayscale PNG ([`encode_png`]).
+/// PNG bytes of DN as 16-bit grayscale samples with their bit depth `bits` (1..=16) in
+/// the PNG's `sBIT` chunk (significant bits, PNG 1.2 § 4.2.6), so that a reader knows
+/// the top DN (`2^bits − 1`, where a target saturates) from the file alone
+/// ([`read_frame_with`] reads it back); fast deflate and the Sub filter as
+/// [`encode_png`].
+///
+/// # Errors
+/// What is wrong, when `bits` is not in 1..=16, `pixels` does not hold `width ×
+/// height` samples, or the encoder fails.
+pub fn encode_dn_png(pixels: &[u16], width: u32, height: u32, bits: u8) -> Result<Vec<u8>, String> {
+    if !(1..=16).contains(&bits) {
+        return Err(format!("a bit depth of {bits}; expected 1..=16"));
+    }
+    if pixels.len() as u64 != u64::from(width) * u64::from(height) {
+        return Err(format!(
+            "{} samples for a {width}x{height} frame",
+            pixels.len()
+        ));
+    }
+    encode_dn_png_checked(pixels, width, height, bits).map_err(|e| e.to_string())
+}
+
+/// [`encode_dn_png`] once its arguments are checked.
+fn encode_dn_png_checked(
+    pixels: &[u16],
+    width: u32,
+    height: u32,
+    bits: u8,
+) -> Result<Vec<u8>, png::EncodingError> {
+    let mut out = Vec::with_capacity(2 * pixels.len() + height as usize + PNG_OVERHEAD_BYTES);
+    let mut encoder = png::Encoder::new(&mut out, width, height);
+    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_depth(png::BitDepth::Sixteen);
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::Filter::Sub);
+    let mut writer = encoder.write_header()?;
+    writer.write_chunk(png::chunk::sBIT, &[bits])?;
+    let big_endian: Vec<u8> = pixels.iter().flat_map(|v| v.to_be_bytes()).collect();
+    writer.write_image_data(&big_endian)?;
+    writer.finish()?;
+    Ok(out)
+}
+
+/// The `sBIT` depth of a grayscale PNG file (its significant bits, 1..=16), or `None`
+/// when the file is not a PNG, cannot be read or has no such chunk. Reads the chunks
+/// before the image data only.
+pub fn png_significant_bits(path: &Path) -> Option<u8> {
+    let file = std::fs::File::open(path).ok()?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .ok()?;
+    let info = reader.info();
+    match (info.color_type, info.sbit.as_deref()) {
+        (png::ColorType::Grayscale, Some(&[s])) => Some(s),
+        _ => None,
+    }
+}
+
+/// Writes DN as a 16-bit grayscale PNG with the frame's bit depth ([`encode_dn_png`]).
 ///
 /// # Errors
 /// An I/O or encoding error, naming the file.
@@ -469,12 +540,130 @@ pub fn write_png16(path: &Path, frame: &FrameBuf) -> Result<(), FrameFileError> 
         path: path.to_path_buf(),
         problem,
     };
-    let png = encode_png(
-        &native_bytes(&frame.pixels),
+    let png = encode_dn_png(
+        &frame.pixels,
         frame.width as u32,
         frame.height as u32,
-        image::ExtendedColorType::L16,
+        frame.bits,
     )
     .map_err(|e| fail(format!("cannot encode: {e}")))?;
     std::fs::write(path, png).map_err(|e| fail(format!("cannot write: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file of this test's own in the system's temporary directory, removed on drop.
+    struct TempFile(PathBuf);
+
+    impl TempFile {
+        fn new(name: &str, bytes: &[u8]) -> Self {
+            let path =
+                std::env::temp_dir().join(format!("tirroi-image-io-{}-{name}", std::process::id()));
+            std::fs::write(&path, bytes).unwrap();
+            TempFile(path)
+        }
+    }
+
+    impl Drop for TempFile {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    /// The chunks of a PNG file as (type, data), parsed by hand from the format (PNG 1.2
+    /// § 3.2: signature, then length, type, data, CRC per chunk), independent of the
+    /// `png` crate that wrote them.
+    fn chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        let mut out = Vec::new();
+        let mut at = 8;
+        while at < bytes.len() {
+            let len = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+            let kind: [u8; 4] = bytes[at + 4..at + 8].try_into().unwrap();
+            out.push((kind, bytes[at + 8..at + 8 + len].to_vec()));
+            at += 12 + len;
+        }
+        out
+    }
+
+    /// A 12-bit frame with its top DN (4095) in it: 16 × 8 px.
+    fn frame_12_bit() -> Vec<u16> {
+        (0..128u16)
+            .map(|i| if i == 77 { 4095 } else { 100 + 7 * i })
+            .collect()
+    }
+
+    #[test]
+    fn the_bit_depth_goes_into_sbit_right_after_the_header() {
+        let png = encode_dn_png(&frame_12_bit(), 16, 8, 12).unwrap();
+        let chunks = chunks(&png);
+        let kinds: Vec<&[u8; 4]> = chunks.iter().map(|(k, _)| k).collect();
+        assert_eq!(kinds[..2], [b"IHDR", b"sBIT"]);
+        assert_eq!(chunks[1].1, [12]);
+        // IHDR: 16 × 8, 16-bit grayscale.
+        assert_eq!(chunks[0].1[..10], [0, 0, 0, 16, 0, 0, 0, 8, 16, 0]);
+    }
+
+    #[test]
+    fn a_rendered_frame_is_read_back_at_its_own_depth() {
+        let pixels = frame_12_bit();
+        let file = TempFile::new("12.png", &encode_dn_png(&pixels, 16, 8, 12).unwrap());
+        assert_eq!(png_significant_bits(&file.0), Some(12));
+        let (frame, warnings) = read_frame_with(&file.0, &ReadOptions::default()).unwrap();
+        // Without sBIT, a 16-bit file whose DN fit 14 bits was read at 14: 4095 would not
+        // be the top DN, and a saturated target would not look saturated.
+        assert_eq!(
+            (frame.bits, frame.pixels, warnings),
+            (12, pixels, Vec::<String>::new())
+        );
+        // `--bits` still decides when given.
+        assert_eq!(read_frame(&file.0, Some(16)).unwrap().bits, 16);
+        for bits in [1, 8, 14, 16] {
+            let pixels = vec![((1u32 << bits) - 1) as u16; 4];
+            let file = TempFile::new("any.png", &encode_dn_png(&pixels, 2, 2, bits).unwrap());
+            assert_eq!(read_frame(&file.0, None).unwrap().bits, bits, "{bits} bits");
+        }
+    }
+
+    #[test]
+    fn without_sbit_or_against_the_data_the_depth_is_guessed() {
+        let pixels = frame_12_bit();
+        let plain =
+            encode_png(&native_bytes(&pixels), 16, 8, image::ExtendedColorType::L16).unwrap();
+        assert!(chunks(&plain).iter().all(|(k, _)| k != b"sBIT"));
+        let file = TempFile::new("plain.png", &plain);
+        assert_eq!(png_significant_bits(&file.0), None);
+        assert_eq!(read_frame(&file.0, None).unwrap().bits, 14);
+        // An sBIT of 10 with a DN of 4095: the data win, with a warning.
+        let file = TempFile::new("lying.png", &encode_dn_png(&pixels, 16, 8, 10).unwrap());
+        let (frame, warnings) = read_frame_with(&file.0, &ReadOptions::default()).unwrap();
+        assert_eq!(frame.bits, 14);
+        assert_eq!(warnings.len(), 1);
+        assert!(
+            warnings[0].contains("sBIT chunk says 10 bits"),
+            "{warnings:?}"
+        );
+    }
+
+    #[test]
+    fn bad_depths_and_sizes_are_errors_not_files() {
+        let pixels = frame_12_bit();
+        assert!(
+            encode_dn_png(&pixels, 16, 8, 0)
+                .unwrap_err()
+                .contains("expected 1..=16")
+        );
+        assert!(
+            encode_dn_png(&pixels, 16, 8, 17)
+                .unwrap_err()
+                .contains("expected 1..=16")
+        );
+        assert!(
+            encode_dn_png(&pixels, 16, 9, 12)
+                .unwrap_err()
+                .contains("16x9")
+        );
+    }
 }
