@@ -24,12 +24,13 @@ use common::Rng;
 use common::*;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+use tirroi_core::capacity::ConstInit;
 use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, BlobRule, DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE,
-    TRACKED_SCORE_PERMILLE,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, DEEP_SPACE_SCORE_PERMILLE,
+    SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, rated_spots,
 };
 use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
@@ -64,12 +65,14 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
-        // (spot, link_cells, look, candidate floor): proptest's tuples end at 12.
+        // (spot, link_cells, look, candidate floor, spots compete below): proptest's
+        // tuples end at 12.
         (
             any::<bool>(),
             prop_oneof![Just(2u8), 1u8..=3],
             look(),
             prop_oneof![Just(None), (0u16..=1000).prop_map(Some)],
+            prop_oneof![Just(800u16), 0u16..=1000],
         ),
     )
         .prop_map(
@@ -85,7 +88,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
-                (spot, link_cells, look, candidate_floor_permille),
+                (spot, link_cells, look, candidate_floor_permille, spot_competes_below_permille),
             )| {
                 AutoV2 {
                     prior,
@@ -101,6 +104,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     small_target,
                     candidates,
                     spot,
+                    spot_competes_below_permille,
                     link_cells,
                     candidate_floor_permille,
                 }
@@ -246,7 +250,8 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
                 TRACKED_SCORE_PERMILLE
             } else if let Some((roi, score)) = work.spot() {
-                // Stage 5e's box: the other stages answered no target.
+                // Stage 5e's box: the other stages answered no target, or their box was
+                // rated below `spot_competes_below_permille` and lower than the spot.
                 prop_assert!(det.spot, "{d:?}");
                 prop_assert_eq!(Some(roi), d.roi);
                 score
@@ -402,11 +407,12 @@ proptest! {
     /// Parameters out of bounds: an error naming the field, never a panic, on any frame.
     #[test]
     fn parameters_out_of_bounds_are_errors(
-        which in 0u8..9,
+        which in 0u8..10,
         seed in any::<u64>(),
     ) {
         let img = frame(seed, 64, 48, 14);
         let bad = match which {
+            8 => AutoV2 { spot_competes_below_permille: 1001, ..AutoV2::default() },
             0 => AutoV2 { fine_sigma: 0, ..AutoV2::default() },
             1 => AutoV2 { cell_score: 4097, ..AutoV2::default() },
             2 => AutoV2 { min_score_permille: 1001, ..AutoV2::default() },
@@ -558,4 +564,70 @@ proptest! {
             prop_assert!(on_border && inside && small, "{r:?} in {w}x{h}");
         }
     }
+}
+
+/// Stage 5e competing with a weak answer (`AutoV2::spot_competes_below_permille`),
+/// against its rule built from parts: the answer without competition (0), and the
+/// frame's rated spots from `learned::rated_spots` (the stage's own rating, called on
+/// its own). With competition at 1000 the answer is the most confident spot (its box
+/// and P) where that is rated above the other stages' box, else that box unchanged; a
+/// frame without a box keeps stage 5e's usual answer. Both branches occur on the
+/// frames drawn.
+#[test]
+fn spots_replace_a_weaker_answer_and_only_that() {
+    let mut scratch = Box::new(AutoV2Scratch::new());
+    let mut spot_work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
+    let (mut replaced, mut kept) = (0, 0);
+    for seed in 0..160u64 {
+        let (w, h) = (96 + (seed as usize % 5) * 40, 72 + (seed as usize % 3) * 40);
+        let mut img = frame(seed, w, h, 14);
+        // A small target, a 3×3 block a quarter of the 14-bit range above what lies
+        // there, where a box of the other stages may or may not be.
+        let (sx, sy) = (
+            8 + (seed as usize * 37) % (w - 16),
+            8 + (seed as usize * 53) % (h - 16),
+        );
+        for y in sy..sy + 3 {
+            for x in sx..sx + 3 {
+                let v = img.at(x, y);
+                *v = v.saturating_add(4096).min(16_383);
+            }
+        }
+        let f = img.frame();
+        // The gate open (the rule holds at any gate; synthetic frames' spots are rated
+        // low by a forest trained on renders, so open it is where both branches occur).
+        let alone = AutoV2 {
+            spot_competes_below_permille: 0,
+            min_score_permille: 0,
+            ..AutoV2::default()
+        };
+        let competing = AutoV2 {
+            spot_competes_below_permille: 1000,
+            ..alone
+        };
+        let before = alone.detect(&f, &mut scratch).unwrap();
+        let after = competing.detect(&f, &mut scratch).unwrap();
+        let best = rated_spots(&f, &mut spot_work).into_iter().flatten().fold(
+            None::<(Roi, u16)>,
+            |b, r| match b {
+                Some((_, s)) if s >= r.score_permille => b,
+                _ => Some((r.roi, r.score_permille)),
+            },
+        );
+        match (before.roi, best) {
+            (Some(_), Some((roi, score))) if score > before.score_permille => {
+                assert_eq!(
+                    (after.roi, after.score_permille),
+                    (Some(roi), score),
+                    "seed {seed}"
+                );
+                replaced += 1;
+            }
+            _ => {
+                assert_eq!(after, before, "seed {seed}");
+                kept += usize::from(before.roi.is_some());
+            }
+        }
+    }
+    assert!(replaced > 0 && kept > 0, "replaced {replaced}, kept {kept}");
 }

@@ -97,6 +97,12 @@ fuzz_target!(|data: &[u8]| {
         },
         candidates: 1 + ((data[2] >> 4) & 3),
         spot: data[3] & 0x01 == 0,
+        // The default, or any of 0..=1000 (0: the spots do not compete).
+        spot_competes_below_permille: if data[3] & 0x02 == 0 {
+            AutoV2::DEFAULT.spot_competes_below_permille
+        } else {
+            (u16::from(data[7]) * 4).min(1000)
+        },
         // 1..=3 (the width's byte's top bits: every value is also a width).
         link_cells: 1 + (data[0] >> 6) % 3,
         candidate_floor_permille: None,

@@ -182,6 +182,13 @@ fn main() {
                     candidates,
                     link_cells,
                     prescreen,
+                    // `predict-all`: the winner's own box (the spots do not compete), so
+                    // that each row's box is the one its statistics rate.
+                    spot_competes_below_permille: if mode == "predict-all" {
+                        0
+                    } else {
+                        AutoV2::default().spot_competes_below_permille
+                    },
                     ..AutoV2::default()
                 };
                 let mut d = gate_off.detect(&frame, &mut scratch).expect("detect");
