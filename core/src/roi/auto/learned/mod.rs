@@ -1240,7 +1240,6 @@ impl AutoV2 {
             {
                 let s = self.spot_stage(frame, work, win, lv);
                 if s.roi.is_some() && s.score_permille > d.score_permille {
-                    work.candidate = None;
                     return s;
                 }
                 // The other stage's box is the answer: the spot is no telemetry of it.
