@@ -8,6 +8,13 @@
 //! at most its halo) is cut by a fixed number of pixels per side, chosen on our
 //! family-A renders (`AutoV2::saturated_erode_px`); a side on the frame's edge is
 //! kept (the target goes on beyond it).
+//!
+//! Only a target saturated *whole* is its blob: a hot face of a larger body saturates
+//! too, with the body's cooler faces beyond the halo (session 47: on family A's
+//! radiometry frames such a face was cut to a 1×1 … 13×17 px box of a 5×4 … 24×27 px
+//! target). So the blob is cut only when the ring just beyond its halo lies at the
+//! level of the ring outside that ([`continues_beyond`]); otherwise the box stays the
+//! earlier stages' and the body stage grows it.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -20,6 +27,95 @@ pub const PSF_RADIUS_PX: u16 = 2;
 /// Fewest pixels at the top DN for a box to count as a saturated blob: a 2×2 core (hot
 /// pixels come alone).
 pub const MIN_BLOB_PX: u32 = 4;
+
+/// Width, px, of the two rings [`continues_beyond`] compares: the near ring, just
+/// beyond the blob's halo (Chebyshev distance [`PSF_RADIUS_PX`] + 1 ..=
+/// [`PSF_RADIUS_PX`] + 2 from the blob's box, where a target saturated whole has put no
+/// light), and the far ring outside it (the surroundings' level and spread).
+pub const RING_PX: u16 = 2;
+
+/// A near-ring pixel departs from the surroundings when it differs from the far
+/// ring's mean by more than this many times the far ring's mean absolute deviation
+/// (at least 1 DN): 4 of them (about 3 σ of Gaussian noise) leave noise, smooth Earth
+/// texture and the camera's shading across a large blob in place. (Means, not
+/// medians: with medians a shading gradient across a large blob's rings, 0 DN on one
+/// side and 150 DN on the other, departed — family A's detection rows fell by 0.02–0.12.
+/// The price: a body that also fills more than about 1/8 of the far ring widens the
+/// spread it is measured against and is not seen; its face is cut as before.)
+pub const DEPART_SPREAD_FACTOR: u64 = 4;
+
+/// The target goes on beyond its blob when more than 1/10 of the near ring departs
+/// (family A, session 47: blobs that were the whole target 0–5 % — the 5 % one
+/// sprinkle of noise on 0 DN deep space — and hot faces of a larger body 12–42 %).
+pub const DEPART_SHARE_DIVISOR: u64 = 10;
+
+/// Calls `f` with every pixel value at Chebyshev distance `from..=to` px (`from` ≥ 1)
+/// from `hull`, inside the frame.
+fn for_each_ring_px(frame: &Frame<'_>, hull: Roi, from: u16, to: u16, mut f: impl FnMut(u16)) {
+    let (fw, fh) = (frame.width(), frame.height());
+    let (from, to) = (usize::from(from), usize::from(to));
+    let (hx0, hy0) = (usize::from(hull.x0), usize::from(hull.y0));
+    let (hx1, hy1) = (usize::from(hull.x1), usize::from(hull.y1));
+    let (x0, x1) = (hx0.saturating_sub(to), (hx1 + to).min(fw));
+    // The columns at distance `from..=to` left and right of the hull.
+    let left = x0..(hx0 + 1).saturating_sub(from).max(x0);
+    let right = (hx1 + from - 1).min(x1)..x1;
+    for y in hy0.saturating_sub(to)..(hy1 + to).min(fh) {
+        let Some(row) = frame.row(y) else {
+            continue;
+        };
+        let dy = if y < hy0 {
+            hy0 - y
+        } else {
+            (y + 1).saturating_sub(hy1)
+        };
+        if dy >= from {
+            row.get(x0..x1)
+                .unwrap_or_default()
+                .iter()
+                .for_each(|&v| f(v));
+        } else {
+            row.get(left.clone())
+                .unwrap_or_default()
+                .iter()
+                .for_each(|&v| f(v));
+            row.get(right.clone())
+                .unwrap_or_default()
+                .iter()
+                .for_each(|&v| f(v));
+        }
+    }
+}
+
+/// True when the target goes on beyond the saturated blob `hull` (the blob's box):
+/// more than 1/[`DEPART_SHARE_DIVISOR`] of the near ring departs from the far ring's
+/// level (see [`RING_PX`], [`DEPART_SPREAD_FACTOR`]). False when the far ring lies
+/// wholly outside the frame. Three passes over the rings (each about 16 × the hull's
+/// perimeter in pixels): run only on a box that is a saturated blob otherwise.
+fn continues_beyond(frame: &Frame<'_>, hull: Roi) -> bool {
+    let near = (PSF_RADIUS_PX + 1, PSF_RADIUS_PX + RING_PX);
+    let far = (near.1 + 1, near.1 + RING_PX);
+    let (mut sum, mut n) = (0u64, 0u64);
+    for_each_ring_px(frame, hull, far.0, far.1, |v| {
+        sum += u64::from(v);
+        n += 1;
+    });
+    if n == 0 {
+        return false;
+    }
+    let level = sum / n;
+    let mut deviation = 0u64;
+    for_each_ring_px(frame, hull, far.0, far.1, |v| {
+        deviation += u64::from(v).abs_diff(level);
+    });
+    let limit = DEPART_SPREAD_FACTOR * (deviation / n).max(1);
+    let (mut near_px, mut departing) = (0u64, 0u64);
+    for_each_ring_px(frame, hull, near.0, near.1, |v| {
+        near_px += 1;
+        departing += u64::from(u64::from(v).abs_diff(level) > limit);
+    });
+    departing * DEPART_SHARE_DIVISOR > near_px
+}
 
 /// The box of the pixels of `roi` at the frame's top DN and how many there are.
 fn saturated_hull(frame: &Frame<'_>, roi: Roi) -> (Roi, u32) {
@@ -81,7 +177,8 @@ fn cut_span(a: u16, b: u16, e: u16, limit: u16) -> (u16, u16) {
 /// The box of the saturated pixels of `roi` when `roi` is a saturated blob: at least
 /// [`MIN_BLOB_PX`] pixels at the top DN, `roi` reaching at most [`PSF_RADIUS_PX`] + 1
 /// px beyond their box on every side (the blob and its halo, not a larger body with a
-/// saturated face); `None` otherwise.
+/// saturated face) and the surroundings beyond the halo at one level (the target does
+/// not go on beyond it, [`continues_beyond`]); `None` otherwise.
 fn blob_hull(frame: &Frame<'_>, roi: Roi) -> Option<Roi> {
     if roi.x1 <= roi.x0 || roi.y1 <= roi.y0 {
         return None;
@@ -96,7 +193,7 @@ fn blob_hull(frame: &Frame<'_>, roi: Roi) -> Option<Roi> {
         && hull.y0 - roi.y0 <= reach
         && roi.x1 - hull.x1 <= reach
         && roi.y1 - hull.y1 <= reach;
-    halo_only.then_some(hull)
+    (halo_only && !continues_beyond(frame, hull)).then_some(hull)
 }
 
 /// True when `roi` is a saturated blob and its halo ([`saturated_box`] cuts it).
@@ -105,10 +202,11 @@ pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
 }
 
 /// `roi` cut to the saturated target inside it (see the module): when `roi` holds at
-/// least [`MIN_BLOB_PX`] pixels at the top DN and reaches at most
+/// least [`MIN_BLOB_PX`] pixels at the top DN, reaches at most
 /// [`PSF_RADIUS_PX`] + 1 px beyond their box on every side (it is that blob and its
-/// halo, not a larger body with a saturated face), the blob's box cut by `erode_px` per
-/// side off the frame's edges; otherwise `roi` unchanged. The result lies inside `roi`.
+/// halo, not a larger body with a saturated face) and the target does not go on
+/// beyond the halo ([`continues_beyond`]), the blob's box cut by `erode_px` per side
+/// off the frame's edges; otherwise `roi` unchanged. The result lies inside `roi`.
 pub fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
     let Some(hull) = blob_hull(frame, roi) else {
         return roi;
@@ -174,6 +272,88 @@ mod tests {
         let flat = std::vec![700u16; FRAME_WIDTH * FRAME_HEIGHT];
         let frame = Frame::new(&flat, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         assert_eq!(saturated_box(&frame, found, 2), found);
+    }
+
+    /// The rings against a brute-force walk of the frame (Chebyshev distance of every
+    /// pixel from the hull), hulls in the middle, on the edges and in a corner.
+    #[test]
+    fn rings_hold_exactly_the_pixels_at_their_distance() {
+        let (w, h) = (40usize, 30usize);
+        let px: std::vec::Vec<u16> = (0..w * h).map(|i| i as u16).collect();
+        let frame = Frame::new(&px, w, h, 12).unwrap();
+        let hulls = [
+            Roi::new(10, 10, 14, 13),
+            Roi::new(0, 0, 3, 2),
+            Roi::new(37, 5, 40, 30),
+            Roi::new(18, 0, 19, 1),
+        ];
+        for hull in hulls {
+            for (from, to) in [(1u16, 2u16), (3, 4), (5, 6), (1, 1), (2, 7)] {
+                let mut got = std::vec::Vec::new();
+                for_each_ring_px(&frame, hull, from, to, |v| got.push(v));
+                got.sort_unstable();
+                let dist = |a: usize, lo: u16, hi: u16| {
+                    let (lo, hi) = (usize::from(lo), usize::from(hi));
+                    if a < lo {
+                        lo - a
+                    } else {
+                        (a + 1).saturating_sub(hi)
+                    }
+                };
+                let want: std::vec::Vec<u16> = (0..w * h)
+                    .filter(|&i| {
+                        let d = dist(i % w, hull.x0, hull.x1).max(dist(i / w, hull.y0, hull.y1));
+                        (usize::from(from)..=usize::from(to)).contains(&d)
+                    })
+                    .map(|i| i as u16)
+                    .collect();
+                assert_eq!(got, want, "{hull:?} {from}..={to}");
+            }
+        }
+    }
+
+    /// A hot face of a larger body (a saturated 8×6 face on a 2 000 DN body whose
+    /// cooler part goes on 4 px beyond the halo on two sides, over 700 DN) is no blob:
+    /// its box is left to the body stage; the same face alone is cut, with a few noise
+    /// spikes around it or without.
+    #[test]
+    fn a_saturated_face_of_a_larger_body_is_not_cut() {
+        let (w, h) = (120usize, 80usize);
+        let top = 4095u16;
+        let face = (50usize, 30usize, 58usize, 36usize);
+        let draw = |body: bool, spikes: bool| {
+            let mut px = std::vec![700u16; w * h];
+            for y in 0..h {
+                for x in 0..w {
+                    let near_face = (face.0 - 2..face.2 + 2).contains(&x)
+                        && (face.1 - 2..face.3 + 2).contains(&y);
+                    let in_body = (face.0 - 2..face.2 + 6).contains(&x)
+                        && (face.1 - 2..face.3 + 6).contains(&y);
+                    if near_face {
+                        px[y * w + x] = top;
+                    } else if body && in_body {
+                        px[y * w + x] = 2000;
+                    }
+                }
+            }
+            if spikes {
+                // Two hot pixels in the near ring (1 of 10 would be 9 of its 88).
+                px[(face.1 - 5) * w + face.0] = 1900;
+                px[(face.3 + 3) * w + face.2 + 2] = 1900;
+            }
+            px
+        };
+        let found = Roi::new(47, 27, 61, 39);
+        let with_body = draw(true, false);
+        let frame = Frame::new(&with_body, w, h, 12).unwrap();
+        assert!(!is_saturated_blob(&frame, found));
+        assert_eq!(saturated_box(&frame, found, 2), found);
+        for spikes in [false, true] {
+            let alone = draw(false, spikes);
+            let frame = Frame::new(&alone, w, h, 12).unwrap();
+            assert!(is_saturated_blob(&frame, found), "spikes {spikes}");
+            assert_eq!(saturated_box(&frame, found, 2), Roi::new(50, 30, 58, 36));
+        }
     }
 
     #[test]
