@@ -11,6 +11,7 @@
 //! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
 //! | `framed-holes-S`, S = 2, 3 | 2 | `holes-S` inside an 8-px margin at a quarter of the range: a saturated blob over nearly the whole frame that passes `auto-v2`'s gate, so its refinement, body stage and shape statistics run over the whole frame (session 32: with the retrained forest `holes-3` no longer does) |
 //! | `plate-holes-S`, S = 2, 3 | 2 | `holes-S` on a plate at half the range, the margin on the top and left only: `auto`'s refinement scans every row and column of its region to the end without a boundary, in the whole frame and in the tracking window at the top-left corner (session 33: that small region counted 2.3× the refinement's per-pixel charge of the time) |
+//! | `weak-blob-S`, S = 2, 3 | 2 | `holes-S` on a saturated plate reaching the right and bottom edges, its top and left margin [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`] under the top: the blob model rates the blob over the gate but under `auto-v2`'s 800 ‰, so the region stages' whole-frame pass runs and then stage 5e's spots compete with it (session 47: the two together, which no other case reaches) |
 //! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
 //! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
 //! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: a nearly flat score over the bins between, but not flat enough (Otsu refines 2 bins) |
@@ -57,6 +58,10 @@ pub enum Case {
     /// saturated, and the margin on the top and left sides only: no boundary ends a
     /// row's scan from the right or a column's from the bottom.
     PlateHoles(usize),
+    /// [`Case::Holes`] on a saturated plate reaching the right and bottom edges, its
+    /// top and left margin ([`FRAME_MARGIN_PX`]) [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`] under
+    /// the top DN: a blob whose confidence passes the gate but not the spots' 800 ‰.
+    WeakBlob(usize),
     /// Uniform noise over 0..=MAX_DN from seed `N`.
     Noise(u64),
     /// Each pixel 0 or MAX_DN at random, from seed `N`.
@@ -87,6 +92,11 @@ const DOT_SPACINGS_PX: [usize; 2] = [2, 3];
 /// Margin around the plate of the framed lattices, px (one cell: the winner does not
 /// touch the frame's sides).
 pub const FRAME_MARGIN_PX: usize = 8;
+/// How far under the top DN the margin of [`Case::WeakBlob`] lies: surroundings this
+/// close to the top lower the blob model's ring depth, so the blob is rated 0.735
+/// (S = 3) and 0.67 (S = 2) on the host, between the gate (550 ‰) and the 800 ‰ under
+/// which the spots compete; 512 DN under the top rated it 0.812 (no competition).
+pub const WEAK_BLOB_MARGIN_BELOW_TOP_DN: u16 = 256;
 /// Seeds of the noise frames.
 const NOISE_SEEDS: [u64; 4] = [1, 2, 3, 4];
 /// Seeds of the salt-and-pepper frames.
@@ -104,7 +114,7 @@ const TILE_LENGTHS: [usize; 4] = [3, 7, 31, 329];
 /// Number of cases ([`case`] is `Some` for `0..COUNT`).
 pub const COUNT: usize = MAX_CHECKER_PERIOD_PX
     + 2 * STRIPE_PERIODS_PX.len()
-    + 4 * DOT_SPACINGS_PX.len()
+    + 5 * DOT_SPACINGS_PX.len()
     + NOISE_SEEDS.len()
     + SALT_PEPPER_SEEDS.len()
     + SPIKE_SEEDS.len()
@@ -146,6 +156,9 @@ pub fn case(index: usize) -> Option<Case> {
     }
     if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
         return DOT_SPACINGS_PX.get(k).map(|&s| Case::PlateHoles(s));
+    }
+    if let Some(k) = group(&mut i, DOT_SPACINGS_PX.len()) {
+        return DOT_SPACINGS_PX.get(k).map(|&s| Case::WeakBlob(s));
     }
     if let Some(k) = group(&mut i, NOISE_SEEDS.len()) {
         return NOISE_SEEDS.get(k).map(|&s| Case::Noise(s));
@@ -278,16 +291,16 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
             Case::StripesH(p) => on((y / p) % 2 == 1),
             Case::Dots(s) => on(x % s == 0 && y % s == 0),
             Case::Holes(s) => on(!(x % s == 0 && y % s == 0)),
-            Case::FramedHoles(s) | Case::PlateHoles(s) => {
-                let (plate, right_px, bottom_px) = if matches!(case, Case::PlateHoles(_)) {
-                    (MAX_DN / 2, 0, 0)
-                } else {
-                    (MAX_DN, FRAME_MARGIN_PX, FRAME_MARGIN_PX)
+            Case::FramedHoles(s) | Case::PlateHoles(s) | Case::WeakBlob(s) => {
+                let (plate, margin, right_px, bottom_px) = match case {
+                    Case::PlateHoles(_) => (MAX_DN / 2, MAX_DN / 4, 0, 0),
+                    Case::WeakBlob(_) => (MAX_DN, MAX_DN - WEAK_BLOB_MARGIN_BELOW_TOP_DN, 0, 0),
+                    _ => (MAX_DN, MAX_DN / 4, FRAME_MARGIN_PX, FRAME_MARGIN_PX),
                 };
                 let inside = (FRAME_MARGIN_PX..FRAME_WIDTH - right_px).contains(&x)
                     && (FRAME_MARGIN_PX..FRAME_HEIGHT - bottom_px).contains(&y);
                 match (inside, x % s == 0 && y % s == 0) {
-                    (false, _) => MAX_DN / 4,
+                    (false, _) => margin,
                     (true, true) => 0,
                     (true, false) => plate,
                 }
@@ -318,6 +331,7 @@ impl fmt::Display for Case {
             Case::Holes(s) => write!(f, "holes-{s}"),
             Case::FramedHoles(s) => write!(f, "framed-holes-{s}"),
             Case::PlateHoles(s) => write!(f, "plate-holes-{s}"),
+            Case::WeakBlob(s) => write!(f, "weak-blob-{s}"),
             Case::Noise(n) => write!(f, "noise-{n}"),
             Case::SaltPepper(n) => write!(f, "salt-pepper-{n}"),
             Case::Spikes(n) => write!(f, "spikes-{n}"),
