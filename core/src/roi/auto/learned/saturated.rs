@@ -12,9 +12,9 @@
 //! Only a target saturated *whole* is its blob: a hot face of a larger body saturates
 //! too, with the body's cooler faces beyond the halo (session 47: on family A's
 //! radiometry frames such a face was cut to a 1×1 … 13×17 px box of a 5×4 … 24×27 px
-//! target). So the blob is cut only when the ring just beyond its halo lies at the
-//! level of the ring outside that ([`continues_beyond`]); otherwise the box stays the
-//! earlier stages' and the body stage grows it.
+//! target). So the blob is cut only when the ring just beyond its halo is not
+//! brighter than the ring outside that ([`continues_beyond`]); otherwise the box stays
+//! the earlier stages' and the body stage grows it.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -108,8 +108,9 @@ fn for_each_ring_px(
 /// [`RING_PX`] of the frame's edge are left out: the far ring beyond them lies outside
 /// the frame, so the level they are judged by would be the other sides' (a blob at the
 /// edge beside the Earth on that side only). False when the far ring lies wholly
-/// outside the frame. Three passes over the rings (each about 16 × the hull's
-/// perimeter in pixels): run only on a box that is a saturated blob otherwise.
+/// outside the frame. Three passes over the rings, each 2 px wide: 4 × (w + h) + 48
+/// pixels (near) and + 80 (far) for a w × h hull, run only on a box that is otherwise
+/// a saturated blob.
 fn continues_beyond(frame: &Frame<'_>, hull: Roi) -> bool {
     let near = (PSF_RADIUS_PX + 1, PSF_RADIUS_PX + RING_PX);
     let far = (near.1 + 1, near.1 + RING_PX);
@@ -195,8 +196,8 @@ fn cut_span(a: u16, b: u16, e: u16, limit: u16) -> (u16, u16) {
 /// The box of the saturated pixels of `roi` when `roi` is a saturated blob: at least
 /// [`MIN_BLOB_PX`] pixels at the top DN, `roi` reaching at most [`PSF_RADIUS_PX`] + 1
 /// px beyond their box on every side (the blob and its halo, not a larger body with a
-/// saturated face) and the surroundings beyond the halo at one level (the target does
-/// not go on beyond it, [`continues_beyond`]); `None` otherwise.
+/// saturated face) and no brighter ring just beyond the halo (the target does not go
+/// on beyond it, [`continues_beyond`]); `None` otherwise.
 fn blob_hull(frame: &Frame<'_>, roi: Roi) -> Option<Roi> {
     if roi.x1 <= roi.x0 || roi.y1 <= roi.y0 {
         return None;
