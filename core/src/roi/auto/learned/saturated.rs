@@ -111,7 +111,7 @@ fn for_each_ring_px(
 /// outside the frame. Three passes over the rings, each 2 px wide: 4 × (w + h) + 48
 /// pixels (near) and + 80 (far) for a w × h hull, run only on a box that is otherwise
 /// a saturated blob.
-fn continues_beyond(frame: &Frame<'_>, hull: Roi) -> bool {
+pub fn continues_beyond(frame: &Frame<'_>, hull: Roi) -> bool {
     let near = (PSF_RADIUS_PX + 1, PSF_RADIUS_PX + RING_PX);
     let far = (near.1 + 1, near.1 + RING_PX);
     let (mut sum, mut n) = (0u64, 0u64);
