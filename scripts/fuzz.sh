@@ -13,7 +13,8 @@
 # Needs: a C++ compiler (libFuzzer is built from source by libfuzzer-sys: Debian g++) and
 # cargo-fuzz (installed from crates.io into ~/.cargo/bin when missing). Runs on the stable
 # toolchain: RUSTC_BOOTSTRAP=1 lets it take cargo-fuzz's nightly flags; --sanitizer none
-# because the core has no `unsafe` for AddressSanitizer to watch (fuzz/Cargo.toml).
+# because the core's host build has no `unsafe` for AddressSanitizer to watch (it is
+# forbidden there; only the Cortex-M4/M7 build has inline assembly; fuzz/Cargo.toml).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root/fuzz"

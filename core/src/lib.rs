@@ -97,7 +97,13 @@
 //!
 //! The frame pass [`sensor::expose_frame`] needs nothing beyond its input and output.
 #![no_std]
-#![forbid(unsafe_code)]
+// No `unsafe` anywhere but the Cortex-M4/M7 build's DSP lane operations (inline
+// assembly, `roi::auto::learned::lanes`): every other build forbids it.
+#![cfg_attr(
+    not(all(target_arch = "arm", target_feature = "dsp")),
+    forbid(unsafe_code)
+)]
+#![cfg_attr(all(target_arch = "arm", target_feature = "dsp"), deny(unsafe_code))]
 #![deny(missing_docs)]
 
 pub mod capacity;

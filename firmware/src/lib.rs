@@ -79,12 +79,24 @@ pub struct Workspace<'a> {
     pub tables: &'a mut synth::Tables,
 }
 
+/// Pixel pairs [`run_demo`] checks the core's lane operations on before the frames
+/// (`lanes::self_check`; about 0.5 M instructions on the M7, outside every meter).
+const LANE_CHECK_WORDS: u32 = 4096;
+
 /// Runs the whole demo and hands each [`Event`] to `emit`, in order.
 pub fn run_demo<M: Meter>(ws: &mut Workspace<'_>, meter: &mut M, emit: &mut dyn FnMut(&Event)) {
     emit(&Event::Start {
         frames: frames::FRAMES.len(),
         methods: DEMO_METHODS.len(),
     });
+    // The core's DSP lane operations (`auto-v2`'s cell plane; inline assembly on a
+    // Cortex-M4/M7) against per-lane arithmetic, where no unit test runs.
+    if !tirroi_core::roi::auto::learned::lanes::self_check(LANE_CHECK_WORDS) {
+        emit(&Event::Error {
+            frame: "-",
+            what: "lane operations differ from per-lane arithmetic",
+        });
+    }
     for &method in DEMO_METHODS {
         emit(&Event::Memory {
             method,

@@ -4,6 +4,7 @@
 //! ([`sub_window_extremes`]: the finer look that keeps a 3–12 px target's contrast).
 
 use super::super::super::plane::Window;
+use super::lanes;
 use crate::frame::Frame;
 
 /// Cell side, pixels: two of the 4×4 cells of `auto`'s other planes, so a cell of this
@@ -287,6 +288,11 @@ fn edge_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
 /// bitwise or of them all at most `2^bits − 1`), else through the clamped rows.
 #[inline(always)]
 fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
+    if lanes::DSP {
+        if let Some(cell) = block_lanes(rows, max_dn) {
+            return cell;
+        }
+    }
     let mut any = 0u16;
     for r in rows {
         for &v in r {
@@ -319,6 +325,83 @@ fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16,
         }
     }
     (acc, best, n_sat)
+}
+
+/// [`block_of`] without the clamps (no pixel of `rows` above `max_dn`) on pixel pairs
+/// ([`lanes`]): per pair of a cell row its two steps across and down folded into a
+/// running maximum per lane, its sum, and its larger pixel; the saturated pixels (at
+/// `max_dn`) are counted only when the cell's largest pixel reaches it. The same
+/// sum, step and count as the per-pixel loop (tested against it).
+#[inline(always)]
+fn block_lanes(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> Option<(u32, u16, u8)> {
+    const PAIRS: usize = CELL_PX / 2;
+    let (mut acc, mut steps, mut top) = (0u32, 0u32, 0u32);
+    for j in 0..PAIRS {
+        (acc, steps, top) = pair_column(&rows, 1 + 2 * j, (acc, steps, top));
+    }
+    // The pixels read around the cell: the rows above and below, the columns left and
+    // right (not the corners).
+    let (first, last) = (rows[0], rows[CELL_PX + 1]);
+    for j in 0..PAIRS {
+        let i = 1 + 2 * j;
+        top = lanes::max(
+            top,
+            lanes::max(
+                lanes::pair(first[i], first[i + 1]),
+                lanes::pair(last[i], last[i + 1]),
+            ),
+        );
+    }
+    for mid in &rows[1..=CELL_PX] {
+        top = lanes::max(top, lanes::pair(mid[0], mid[CELL_PX + 1]));
+    }
+    let (s0, s1) = lanes::split(steps);
+    let (t0, t1) = lanes::split(top);
+    let read_max = t0.max(t1);
+    if read_max > max_dn {
+        return None;
+    }
+    let mut n_sat = 0u8;
+    if read_max == max_dn {
+        for mid in &rows[1..=CELL_PX] {
+            for &v in &mid[1..=CELL_PX] {
+                n_sat += u8::from(v >= max_dn);
+            }
+        }
+    }
+    Some((acc, s0.max(s1), n_sat))
+}
+
+/// One column of pairs of [`block_lanes`] (pixels `i`, `i + 1` of the cell's 8 rows):
+/// `(sum, steps, top)` with its pairs added. Down the column the pair above and the pair
+/// itself are carried over from the row before (three words read per step, not five).
+#[inline(always)]
+fn pair_column(
+    rows: &[&[u16; CELL_PX + 2]; CELL_PX + 2],
+    i: usize,
+    (mut acc, mut steps, mut top): (u32, u32, u32),
+) -> (u32, u32, u32) {
+    // `i` is odd and at most 7 (the caller's): every index below is in range; `get`
+    // (no panic path) gives an empty column otherwise.
+    if !(1..CELL_PX).contains(&i) {
+        return (acc, steps, top);
+    }
+    let at = |row: &[u16; CELL_PX + 2]| lanes::pair(row[i], row[i + 1]);
+    let (mut up, mut mid) = (at(rows[0]), at(rows[1]));
+    for k in 1..=CELL_PX {
+        let down = at(rows[k + 1]);
+        let row = rows[k];
+        (steps, acc, top) = lanes::pair_step(
+            (steps, acc, top),
+            (
+                lanes::pair(row[i - 1], row[i]),
+                lanes::pair(row[i + 1], row[i + 2]),
+            ),
+            (up, mid, down),
+        );
+        (up, mid) = (mid, down);
+    }
+    (acc, steps, top)
 }
 
 /// Side of the finer windows the classifier also looks through, pixels: a 3–12 px far
@@ -544,6 +627,61 @@ mod tests {
                 check_cell_plane(&frame, &px, win);
             }
         }
+    }
+
+    /// The pair form of a whole cell ([`block_lanes`], what a Cortex-M4/M7 build runs;
+    /// here on the lane-by-lane operations) against a brute force over its 10 × 10
+    /// pixels: the sum of the inner 8 × 8, the largest two-pixel step across and down
+    /// and the pixels at the top DN, at 8, 14 and 16 bits, with and without saturated
+    /// pixels and with only small steps.
+    #[test]
+    fn cell_pairs_equal_brute_force() {
+        let mut rand = super::super::xorshift32(0x0DD_B10C);
+        let mut saturated_cells = 0u32;
+        for k in 0..30_000u32 {
+            let bits = [8u8, 14, 16][(k % 3) as usize];
+            let top = ((1u32 << bits) - 1) as u16;
+            let (base, spread) = match k % 4 {
+                // Anywhere in range, near the top (saturated pixels), small steps.
+                0 | 1 => (0u32, u32::from(top) + 1),
+                2 => (u32::from(top) - 40, 41),
+                _ => (u32::from(top) / 2, 5),
+            };
+            let px: [[u16; CELL_PX + 2]; CELL_PX + 2] =
+                core::array::from_fn(|_| core::array::from_fn(|_| (base + rand() % spread) as u16));
+            let rows = px.each_ref();
+            let (mut sum, mut best, mut n_sat) = (0u32, 0u16, 0u8);
+            for y in 1..=CELL_PX {
+                for x in 1..=CELL_PX {
+                    sum += u32::from(px[y][x]);
+                    n_sat += u8::from(px[y][x] >= top);
+                    best = best
+                        .max(px[y][x - 1].abs_diff(px[y][x + 1]))
+                        .max(px[y - 1][x].abs_diff(px[y + 1][x]));
+                }
+            }
+            saturated_cells += u32::from(n_sat > 0);
+            assert_eq!(
+                block_lanes(rows, top),
+                Some((sum, best, n_sat)),
+                "block {k}"
+            );
+            assert_eq!(block_of(rows, top), (sum, best, n_sat), "block {k}");
+            // One pixel above the top DN (never in a camera's frame): the pair form
+            // declines when it is read (the clamped rows decide), not in a corner.
+            if bits < 16 {
+                let (y, x) = ((rand() % 10) as usize, (rand() % 10) as usize);
+                let mut over = px;
+                over[y][x] = top + 1;
+                let corner = (y == 0 || y == CELL_PX + 1) && (x == 0 || x == CELL_PX + 1);
+                let got = block_lanes(over.each_ref(), top);
+                assert_eq!(got.is_none(), !corner, "block {k} ({x}, {y})");
+                if corner {
+                    assert_eq!(got, Some((sum, best, n_sat)), "block {k} corner");
+                }
+            }
+        }
+        assert!(saturated_cells > 5_000, "{saturated_cells}");
     }
 
     /// [`fill_cells`] of `win` against the brute force over `px` (the frame's pixels).

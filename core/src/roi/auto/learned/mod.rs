@@ -31,6 +31,7 @@ pub mod features;
 pub mod forest;
 mod forest_trees;
 pub mod half_max;
+pub mod lanes;
 pub mod limb;
 pub mod look;
 pub mod narrow;
