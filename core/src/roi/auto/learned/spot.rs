@@ -25,14 +25,18 @@
 //! Memory: the column sums of the ring's sampled rows and of the hole's (DN and DN² in
 //! 32 bits, of DN brought to 12 bits), 2 words per sampled column each, and of the
 //! core's 3 rows, 1 word per column, in the three integral planes the caller lends
-//! (`auto-v2`'s, free at this stage; every capacity's planes hold them). The spots,
-//! their features and the region's bit rows are on the stack (under 700 B).
+//! (`auto-v2`'s, free at this stage; every capacity's planes hold them). On the stack:
+//! the [`SPOTS`] spots (56 B each on the M7) and the rated spots with their features
+//! (152 B each): 1 664 B for 8 (1 040 B for session 47's 5), and a region's bit rows;
+//! `auto-v2`'s stack peak (12 440 B on the M7, `scripts/flight.sh`) lies elsewhere and
+//! did not move.
 //! Cost (Cortex-M7, `scripts/worst-case.sh`): at most 5.49 M instructions per 328×248
 //! window, 67 per pixel: per sampled row the bands (a row in and a row out, of DN and
 //! DN²) and the core's column sums; per centre of the search grid (every second pixel
 //! of every second row) running sums and a comparison, the variance only where the
 //! contrast passes the noise floor, the division and square root only for a centre
-//! that would enter the spots; then the 5 spots' 3×3 refinement, regions and forest.
+//! that would enter the spots; then the [`SPOTS`] spots' 3×3 refinement, regions and
+//! forest.
 
 use super::features::FrameLevels;
 use super::forest::{self, Node};
@@ -42,10 +46,15 @@ use crate::frame::Frame;
 use crate::roi::Roi;
 use crate::roi::plane::Window;
 
-/// Spots rated per frame: the strongest, at least [`SEPARATION_PX`] apart. On family A
-/// (seed 7001) the target is the strongest spot in 42 % of radiometry-far frames with
-/// signal-to-clutter ≥ 3 and among the five strongest in 56 %.
-pub const SPOTS: usize = 5;
+/// Spots rated per frame: the strongest, at least [`SEPARATION_PX`] apart. 8, chosen on
+/// family A (session 48, the forest as trained on 5 per frame: its rank feature splits
+/// at 0 and 3, so spots 5–7 are rated as the fifth): with 5, 8, 12, 16 spots the summed
+/// mean IoU of famA, paperA, fixA and famAF is 2.4167, 2.4261, 2.4261, 2.4343, the
+/// false alarms on famAE 11, 11, 11, 12 of 300 (famAT 3, 2, 2, 2); the fewest spots of
+/// the best tie without a false alarm added. On today's renders the target is the
+/// strongest spot of 32 % of famAF's frames with signal-to-clutter ≥ 3, among the five
+/// strongest of 43 % and the eight of 47 % (famA's radiometry-far frames: 51, 69, 71 %).
+pub const SPOTS: usize = 8;
 
 /// Integer features of a rated spot (the order of [`spot_features`]).
 pub const SPOT_FEATURES: usize = 21;
