@@ -57,60 +57,13 @@ pub fn max(a: u32, b: u32) -> u32 {
     }
 }
 
-/// Lane by lane, the largest of `best`, `|l − r|` and `|u − d|` (unsigned 16-bit
-/// lanes): the cell plane's two-pixel steps across (`l`, `r`: the pixels left and right
-/// of a pair) and down (`u`, `d`: above and below), folded into the running maximum.
-#[inline(always)]
-pub fn step_max(best: u32, l: u32, r: u32, u: u32, d: u32) -> u32 {
-    #[cfg(all(target_arch = "arm", target_feature = "dsp"))]
-    {
-        let out: u32;
-        // SAFETY: register arithmetic only (see the module). Per lane: `usub16 x, a, b`
-        // gives a − b and sets GE where a ≥ b, so after `usub16 y, b, a`, `sel x, y, x`
-        // takes b − a where b ≥ a and a − b elsewhere: |a − b|. Then the larger of the
-        // two steps, then of it and `best`, by `usub16` + `sel` again.
-        #[allow(unsafe_code)]
-        unsafe {
-            core::arch::asm!(
-                "usub16 {h}, {l}, {r}",
-                "usub16 {t}, {r}, {l}",
-                "sel {h}, {t}, {h}",
-                "usub16 {v}, {u}, {d}",
-                "usub16 {t}, {d}, {u}",
-                "sel {v}, {t}, {v}",
-                "usub16 {t}, {h}, {v}",
-                "sel {h}, {h}, {v}",
-                "usub16 {t}, {h}, {best}",
-                "sel {out}, {h}, {best}",
-                l = in(reg) l,
-                r = in(reg) r,
-                u = in(reg) u,
-                d = in(reg) d,
-                best = in(reg) best,
-                h = out(reg) _,
-                v = out(reg) _,
-                t = out(reg) _,
-                out = lateout(reg) out,
-                options(nostack),
-            );
-        }
-        out
-    }
-    #[cfg(not(all(target_arch = "arm", target_feature = "dsp")))]
-    {
-        let ((b0, b1), (l0, l1), (r0, r1)) = (split(best), split(l), split(r));
-        let ((u0, u1), (d0, d1)) = (split(u), split(d));
-        pair(
-            b0.max(l0.abs_diff(r0)).max(u0.abs_diff(d0)),
-            b1.max(l1.abs_diff(r1)).max(u1.abs_diff(d1)),
-        )
-    }
-}
-
-/// One pair of the cell plane's pass, lane by lane: `steps` folds in `|l − r|` and
-/// `|u − d|` ([`step_max`]), `top` the pair `m` itself ([`max`]), and `sum` adds both
-/// of `m`'s pixels. One block of instructions on a Cortex-M4/M7 (so the compiler keeps
-/// the pair in a register instead of its two pixels for the sum).
+/// One pair of the cell plane's pass, lane by lane (unsigned 16-bit lanes): `steps`
+/// becomes the largest of itself, `|l − r|` and `|u − d|` (the two-pixel steps across,
+/// `l` and `r` the pixels left and right of the pair, and down, `u` and `d` above and
+/// below), `top` the larger of itself and the pair `m` ([`max`]), and `sum` adds both of
+/// `m`'s pixels (modulo 2³², as the instructions add; a cell's sum never comes near it).
+/// One block of instructions on a Cortex-M4/M7 (so the compiler keeps the
+/// pair in a register instead of its two pixels for the sum).
 #[inline(always)]
 pub fn pair_step(
     (steps, sum, top): (u32, u32, u32),
@@ -120,8 +73,11 @@ pub fn pair_step(
     #[cfg(all(target_arch = "arm", target_feature = "dsp"))]
     {
         let (mut steps, mut sum, mut top) = (steps, sum, top);
-        // SAFETY: register arithmetic only (see the module and [`step_max`]); `uxtah`
-        // adds the low lane zero-extended, `add …, lsr #16` the high one.
+        // SAFETY: register arithmetic only (see the module). Per lane: `usub16 x, a, b`
+        // gives a − b and sets GE where a ≥ b, so after `usub16 y, b, a`, `sel x, y, x`
+        // takes b − a where b ≥ a and a − b elsewhere: |a − b|. The larger of two lanes
+        // by `usub16` + `sel` again; `uxtah` adds the low lane zero-extended, `add …,
+        // lsr #16` the high one.
         #[allow(unsafe_code)]
         unsafe {
             core::arch::asm!(
@@ -157,19 +113,24 @@ pub fn pair_step(
     }
     #[cfg(not(all(target_arch = "arm", target_feature = "dsp")))]
     {
+        let ((b0, b1), (l0, l1), (r0, r1)) = (split(steps), split(l), split(r));
+        let ((u0, u1), (d0, d1)) = (split(u), split(d));
         (
-            step_max(steps, l, r, u, d),
-            sum + (m & 0xffff) + (m >> 16),
+            pair(
+                b0.max(l0.abs_diff(r0)).max(u0.abs_diff(d0)),
+                b1.max(l1.abs_diff(r1)).max(u1.abs_diff(d1)),
+            ),
+            sum.wrapping_add(m & 0xffff).wrapping_add(m >> 16),
             max(top, m),
         )
     }
 }
 
-/// Whether [`max`] and [`step_max`] run as the DSP extension's instructions on this
+/// Whether [`max`] and [`pair_step`] run as the DSP extension's instructions on this
 /// build (`true` on a Cortex-M4/M7 build), else lane by lane.
 pub const DSP: bool = cfg!(all(target_arch = "arm", target_feature = "dsp"));
 
-/// Checks [`max`], [`step_max`] and [`pair_step`] as this build runs them (the DSP
+/// Checks [`max`] and [`pair_step`] as this build runs them (the DSP
 /// instructions on a Cortex-M4/M7) against the same arithmetic on each lane alone
 /// (`u16::abs_diff`, `u16::max`, the two pixels added), on `words` pseudo-random pairs
 /// (a fixed xorshift32 stream, 16-bit values over the whole range, every fourth word
@@ -209,7 +170,6 @@ pub fn self_check(words: u32) -> bool {
         let (m0, m1) = lanes(m);
         let want_sum = sum.wrapping_add(u32::from(m0)).wrapping_add(u32::from(m1));
         ok &= max(best, m) == pair(t0, t1);
-        ok &= step_max(best, l, r, u, d) == pair(s0, s1);
         ok &= pair_step((best, sum, best), (l, r), (u, m, d))
             == (pair(s0, s1), want_sum, pair(t0, t1));
     }
