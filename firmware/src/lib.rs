@@ -80,7 +80,7 @@ pub struct Workspace<'a> {
 }
 
 /// Pixel pairs [`run_demo`] checks the core's lane operations on before the frames
-/// (`lanes::self_check`; about 0.5 M instructions on the M7, outside every meter).
+/// (`lanes::self_check`, outside every meter): edge and random values of both lanes.
 const LANE_CHECK_WORDS: u32 = 4096;
 
 /// Runs the whole demo and hands each [`Event`] to `emit`, in order.

@@ -285,7 +285,9 @@ fn edge_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
 /// The sum, largest two-pixel step and saturated count of the 8 × 8 pixels inside
 /// `rows` (10 rows of 10: the cell and a neighbour on every side), first without the
 /// clamps to the top DN `max_dn`, which change nothing when no pixel is above it (the
-/// bitwise or of them all at most `2^bits − 1`), else through the clamped rows.
+/// bitwise or of them all at most `2^bits − 1`), else through the clamped rows. A
+/// Cortex-M4/M7 build first takes the pixel-pair form ([`block_lanes`]), which checks
+/// the same condition by its lane maxima.
 #[inline(always)]
 fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
     if lanes::DSP {
@@ -381,8 +383,9 @@ fn pair_column(
     i: usize,
     (mut acc, mut steps, mut top): (u32, u32, u32),
 ) -> (u32, u32, u32) {
-    // `i` is odd and at most 7 (the caller's): every index below is in range; `get`
-    // (no panic path) gives an empty column otherwise.
+    // `i` is odd and at most 7 (the caller's): every index below is then in range (the
+    // guard says so to the compiler: no panic path, `scripts/panic-never.sh`); any other
+    // `i` leaves the sums as they are.
     if !(1..CELL_PX).contains(&i) {
         return (acc, steps, top);
     }

@@ -136,7 +136,7 @@ pub const DSP: bool = cfg!(all(target_arch = "arm", target_feature = "dsp"));
 /// (a fixed xorshift32 stream, 16-bit values over the whole range, every fourth word
 /// from edge values: 0, 1, 2^14 − 1, 2^15 − 1, 2^15, 2^16 − 1). True when every result
 /// is equal. The flight demo runs it first on every target (`firmware`), where no unit
-/// test runs; about 120 instructions per word.
+/// test runs.
 pub fn self_check(words: u32) -> bool {
     const EDGES: [u16; 6] = [0, 1, 0x3fff, 0x7fff, 0x8000, 0xffff];
     let mut state = 0x1a4e_5eedu32;
