@@ -285,15 +285,13 @@ fn edge_block(frame: &Frame<'_>, xa: usize, ya: usize) -> (u32, u16, u8) {
 /// The sum, largest two-pixel step and saturated count of the 8 × 8 pixels inside
 /// `rows` (10 rows of 10: the cell and a neighbour on every side), first without the
 /// clamps to the top DN `max_dn`, which change nothing when no pixel is above it (the
-/// bitwise or of them all at most `2^bits − 1`), else through the clamped rows. A
-/// Cortex-M4/M7 build first takes the pixel-pair form ([`block_lanes`]), which checks
-/// the same condition by its lane maxima.
+/// bitwise or of them all at most `2^bits − 1`), else through the clamped rows
+/// ([`block_clamped`]). A Cortex-M4/M7 build takes the pixel-pair form instead
+/// ([`block_lanes`]), which checks the same condition by its lane maxima.
 #[inline(always)]
 fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
     if lanes::DSP {
-        if let Some(cell) = block_lanes(rows, max_dn) {
-            return cell;
-        }
+        return block_lanes(rows, max_dn).unwrap_or_else(|| block_clamped(rows, max_dn));
     }
     let mut any = 0u16;
     for r in rows {
@@ -301,30 +299,38 @@ fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16,
             any |= v;
         }
     }
+    if any > max_dn {
+        return block_clamped(rows, max_dn);
+    }
     let mut acc = 0u32;
     let mut best = 0u16;
     let mut n_sat = 0u8;
-    if any <= max_dn {
-        for k in 1..=CELL_PX {
-            // Unrolled: every index is a constant in range (no panic path).
-            let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
-            for i in 1..=CELL_PX {
-                let v = mid[i];
-                n_sat += u8::from(v >= max_dn);
-                acc += u32::from(v);
-                best = best
-                    .max(mid[i - 1].abs_diff(mid[i + 1]))
-                    .max(up[i].abs_diff(down[i]));
-            }
+    for k in 1..=CELL_PX {
+        // Unrolled: every index is a constant in range (no panic path).
+        let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
+        for i in 1..=CELL_PX {
+            let v = mid[i];
+            n_sat += u8::from(v >= max_dn);
+            acc += u32::from(v);
+            best = best
+                .max(mid[i - 1].abs_diff(mid[i + 1]))
+                .max(up[i].abs_diff(down[i]));
         }
-    } else {
-        for w in rows.windows(3) {
-            let &[up, mid, down] = w else { continue };
-            let (a, b, n) = full_inner_cell(mid, &up[..], &down[..], 1, max_dn, best);
-            acc += a;
-            best = b;
-            n_sat += n;
-        }
+    }
+    (acc, best, n_sat)
+}
+
+/// [`block_of`] through the clamped rows ([`full_inner_cell`] on each of the 8): for a
+/// cell with a pixel above the top DN, never in a camera's frame.
+#[inline(always)]
+fn block_clamped(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
+    let (mut acc, mut best, mut n_sat) = (0u32, 0u16, 0u8);
+    for w in rows.windows(3) {
+        let &[up, mid, down] = w else { continue };
+        let (a, b, n) = full_inner_cell(mid, &up[..], &down[..], 1, max_dn, best);
+        acc += a;
+        best = b;
+        n_sat += n;
     }
     (acc, best, n_sat)
 }

@@ -13,7 +13,7 @@
 //! the words to the stack (8.32 M instructions per `auto-v2` call against 8.02 M).
 //! Measured reason for the assembly: on the emulated Cortex-M7 the cell plane took 23
 //! instructions per pixel, 31 % of an `auto-v2` call (`scripts/m7-profile.sh`, session
-//! 48), and `auto-v2` fell from 8.62 M to 7.43 M instructions per call with it
+//! 48), and `auto-v2` fell from 8.62 M to 7.42 M instructions per call with it
 //! (`docs/flight.md` § Session 48). The inputs and outputs are whole words.
 
 /// The pair `(lo, hi)` as one word: `lo` in bits 0–15, `hi` in bits 16–31 (the order of
@@ -156,9 +156,9 @@ pub fn self_check(words: u32) -> bool {
     let mut ok = true;
     for k in 0..words {
         let [best, l, r, u, m, d, sum] = [0u32; 7].map(|_| draw(k));
-        let lanes = |w: u32| split(w);
-        let one = |lane: fn((u16, u16)) -> u16| {
-            let at = |w: u32| lane(lanes(w));
+        // Each lane alone: its step (the largest of best, |l − r|, |u − d|) and top.
+        let lane = |shift: u32| {
+            let at = |w: u32| (w >> shift) as u16;
             (
                 at(best)
                     .max(at(l).abs_diff(at(r)))
@@ -166,8 +166,8 @@ pub fn self_check(words: u32) -> bool {
                 at(best).max(at(m)),
             )
         };
-        let ((s0, t0), (s1, t1)) = (one(|p| p.0), one(|p| p.1));
-        let (m0, m1) = lanes(m);
+        let ((s0, t0), (s1, t1)) = (lane(0), lane(16));
+        let (m0, m1) = split(m);
         let want_sum = sum.wrapping_add(u32::from(m0)).wrapping_add(u32::from(m1));
         ok &= max(best, m) == pair(t0, t1);
         ok &= pair_step((best, sum, best), (l, r), (u, m, d))
