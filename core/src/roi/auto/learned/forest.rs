@@ -90,29 +90,48 @@ pub const fn max_depth_of(nodes: &[Node], roots: &[u16], features: usize) -> usi
     deepest
 }
 
-/// Feature slots of the flat form's per-cell copy: a power of two at least
-/// [`FEATURES`], so a feature index masked by `FEATURE_SLOTS − 1` needs no bounds check.
-const FEATURE_SLOTS: usize = FEATURES.next_power_of_two();
-const _: () = assert!(FEATURES <= FEATURE_SLOTS);
+/// Feature slots of the flat form's per-cell copy: a power of two above [`FEATURES`],
+/// so a feature index masked by `FEATURE_SLOTS − 1` needs no bounds check, and the
+/// last slot ([`ALWAYS_LEFT_SLOT`]) is free to hold 0 for the splits that always go left.
+const FEATURE_SLOTS: usize = (FEATURES + 1).next_power_of_two();
+/// The slot a split that always goes left reads: never a feature, always 0 (its
+/// threshold is 0).
+const ALWAYS_LEFT_SLOT: usize = FEATURE_SLOTS - 1;
+const _: () = assert!(FEATURES < ALWAYS_LEFT_SLOT);
 
-/// A forest laid out for branch-light evaluation, derived at compile time from a node
+/// Low bits of a split word ([`FlatForest::split`]) that hold the feature's slot; the
+/// threshold is the word shifted right by these bits (arithmetic).
+const SLOT_BITS: u32 = 8;
+const _: () = assert!(FEATURE_SLOTS <= 1 << SLOT_BITS);
+
+/// Largest threshold magnitude a split word holds: `|threshold| < 2^23`.
+const THRESHOLD_LIMIT: i32 = 1 << (31 - SLOT_BITS);
+
+/// The per-cell copy of a feature is clamped to `−2^30 ..= 2^30 − 1`, so `threshold −
+/// feature` never leaves the i32 range (|threshold| < 2^23) and its sign is the step
+/// right. Exact: every threshold lies inside the clamp's range, so no comparison moves.
+const FEATURE_LIMIT: i32 = 1 << 30;
+
+/// A forest laid out for branch-free evaluation, derived at compile time from a node
 /// table ([`FlatForest::build`]): each of the `T` trees as a complete binary tree of
-/// depth `D = log2 L` in heap order (children of split `k`: `2k + 1`, `2k + 2`; `L − 1`
-/// splits, then `L` leaves). A leaf of the table above depth `D` becomes splits that
-/// always go left (threshold `i32::MAX`) down to a leaf holding its value, so every
-/// cell walks exactly `D` splits per tree: no leaf test, no data-dependent loop length,
-/// and every index is masked by `L − 1` (no bounds check). The trees are stored largest
+/// depth `D = log2 L` in 1-based heap order (the root at 1, the children of split `k` at
+/// `2k` and `2k + 1`; splits `1..L`, leaves `L..2L`). A leaf of the table above depth `D`
+/// becomes splits that always go left (they read [`ALWAYS_LEFT_SLOT`], 0, against a
+/// threshold of 0) down to a leaf holding its value, so every cell walks exactly `D`
+/// splits per tree: no leaf test, no data-dependent loop length, and every index is
+/// masked by `L − 1` (no bounds check). A split is one word, threshold and slot packed
+/// ([`SLOT_BITS`]), and a step is `k = 2k + sign(threshold − feature)`: on the M7 about
+/// 7 instructions per level with no conditional execution. The trees are stored largest
 /// leaf first ([`FlatForest::score_reaching`]'s early exit); `build` proves that no
 /// partial sum leaves the i32 range, so the order changes no sum. Scores equal
 /// [`score`]'s over the same table, bit for bit (the same comparisons; tested on both
-/// sides of every split of the flight table and on random features).
+/// sides of every split of the flight table, on random features and on the extremes).
 #[derive(Debug, Clone, Copy)]
 pub struct FlatForest<const T: usize, const L: usize> {
-    /// The splits of each tree in heap order (slot `L − 1` unused): threshold and
-    /// feature side by side, one address per level of the walk (two separate arrays
-    /// cost 3 % more instructions per frame on x86-64).
-    pub split: [[Split; L]; T],
-    /// Leaf values, score units, per tree.
+    /// The splits of each tree in 1-based heap order (slot 0 unused), one word each:
+    /// `threshold << SLOT_BITS | slot` (a feature at most the threshold goes left).
+    pub split: [[i32; L]; T],
+    /// Leaf values, score units, per tree (leaf `k` of the heap at `k − L`).
     pub leaf: [[i32; L]; T],
     /// The forest's bias, score units.
     pub bias: i32,
@@ -121,9 +140,17 @@ pub struct FlatForest<const T: usize, const L: usize> {
     pub rest_max: [i32; T],
 }
 
+/// A split word: `threshold` (|threshold| < 2^23, checked at compile time) above the
+/// feature's `slot`.
+const fn split_word(threshold: i32, slot: usize) -> i32 {
+    assert!(
+        threshold > -THRESHOLD_LIMIT && threshold < THRESHOLD_LIMIT,
+        "a threshold too large for a split word"
+    );
+    (threshold << SLOT_BITS) | slot as i32
+}
+
 impl<const T: usize, const L: usize> FlatForest<T, L> {
-    /// Splits per tree.
-    const SPLITS: usize = L - 1;
     /// Levels per tree.
     const DEPTH: u32 = L.trailing_zeros();
 
@@ -132,17 +159,17 @@ impl<const T: usize, const L: usize> FlatForest<T, L> {
     /// Evaluated in a `const`: a mismatch is a compile error.
     pub const fn build(nodes: &[Node], roots: &[u16], bias: i32) -> Self {
         assert!(roots.len() == T, "T is not the table's tree count");
-        assert!(L.is_power_of_two(), "L a power of two");
-        let s = Self::SPLITS;
+        assert!(
+            L.is_power_of_two() && L >= 2,
+            "L a power of two, at least 2"
+        );
         assert!(
             max_depth(nodes, roots) <= Self::DEPTH as usize,
             "L too small for the deepest tree"
         );
+        let always_left = split_word(0, ALWAYS_LEFT_SLOT);
         let mut out = FlatForest {
-            split: [[Split {
-                threshold: i32::MAX,
-                slot: 0,
-            }; L]; T],
+            split: [[always_left; L]; T],
             leaf: [[0; L]; T],
             bias,
             rest_max: [0; T],
@@ -150,33 +177,27 @@ impl<const T: usize, const L: usize> FlatForest<T, L> {
         let order = largest_leaf_first(nodes, roots);
         let mut t = 0;
         while t < T {
-            // Heap position → table node (a table leaf stays in place as it goes left).
+            // Heap position (1-based) → table node (a table leaf stays in place as it
+            // goes left).
             let mut at = [0u16; 256];
-            assert!(s + L <= 256, "depth at most 7 (256 heap slots)");
-            at[0] = roots[order[t] as usize];
-            let mut k = 0;
-            while k < s + L {
+            assert!(2 * L <= 256, "depth at most 7 (256 heap slots)");
+            at[1] = roots[order[t] as usize];
+            let mut k = 1;
+            while k < 2 * L {
                 let n = &nodes[at[k] as usize];
-                if k < s {
+                if k < L {
                     if n.feature == LEAF {
-                        // Always left: any feature ≤ i32::MAX.
-                        out.split[t][k] = Split {
-                            threshold: i32::MAX,
-                            slot: 0,
-                        };
+                        out.split[t][k] = always_left;
+                        at[2 * k] = at[k];
                         at[2 * k + 1] = at[k];
-                        at[2 * k + 2] = at[k];
                     } else {
-                        out.split[t][k] = Split {
-                            threshold: n.threshold,
-                            slot: n.feature as u32,
-                        };
-                        at[2 * k + 1] = n.left;
-                        at[2 * k + 2] = n.right;
+                        out.split[t][k] = split_word(n.threshold, n.feature as usize);
+                        at[2 * k] = n.left;
+                        at[2 * k + 1] = n.right;
                     }
                 } else {
                     assert!(n.feature == LEAF, "a split below depth D");
-                    out.leaf[t][k - s] = n.value;
+                    out.leaf[t][k - L] = n.value;
                 }
                 k += 1;
             }
@@ -210,27 +231,31 @@ impl<const T: usize, const L: usize> FlatForest<T, L> {
         out
     }
 
-    /// The features in a power-of-two array (masked indices: no bounds check).
+    /// The features in a power-of-two array (masked indices: no bounds check), each
+    /// clamped to [`FEATURE_LIMIT`]; [`ALWAYS_LEFT_SLOT`] and the other free slots 0.
     #[inline(always)]
     fn slots(f: &[i32; FEATURES]) -> [i32; FEATURE_SLOTS] {
         let mut slots = [0i32; FEATURE_SLOTS];
         for (slot, &v) in slots.iter_mut().zip(f) {
-            *slot = v;
+            *slot = v.clamp(-FEATURE_LIMIT, FEATURE_LIMIT - 1);
         }
         slots
     }
 
     /// The leaf one tree's splits lead to for the features in `slots`.
     #[inline(always)]
-    fn leaf_of(split: &[Split; L], leaf: &[i32; L], slots: &[i32; FEATURE_SLOTS]) -> i32 {
+    fn leaf_of(split: &[i32; L], leaf: &[i32; L], slots: &[i32; FEATURE_SLOTS]) -> i32 {
         let mask = L - 1;
-        let mut k = 0usize;
+        let mut k = 1usize;
         for _ in 0..Self::DEPTH {
-            let sp = split[k & mask];
-            let right = slots[sp.slot as usize & (FEATURE_SLOTS - 1)] > sp.threshold;
-            k = 2 * k + 1 + usize::from(right);
+            let word = split[k & mask];
+            let feature = slots[word as u32 as usize & (FEATURE_SLOTS - 1)];
+            // threshold − feature < 0 ⟺ feature > threshold: the sign bit steps right.
+            // No overflow: |threshold| < 2^23, |feature| ≤ 2^30 (`slots`' clamp).
+            let right = ((word >> SLOT_BITS).wrapping_sub(feature) as u32 >> 31) as usize;
+            k = 2 * k + right;
         }
-        leaf[k.wrapping_sub(Self::SPLITS) & mask]
+        leaf[k & mask]
     }
 
     /// The forest's score of one cell's features: bias + one leaf per tree, equal to
@@ -280,15 +305,6 @@ impl<const T: usize, const L: usize> FlatForest<T, L> {
 /// flight demo's frames, M7 mean): every tree 8.17 M, 2 trees 7.96 M, **4 trees
 /// 7.96 M** (x86-64 2 % fewer than 2), 8 trees 8.05 M.
 const CHECK_TREES: usize = 4;
-
-/// One split of [`FlatForest`]: a feature at most `threshold` goes left.
-#[derive(Debug, Clone, Copy)]
-pub struct Split {
-    /// The threshold, feature units.
-    pub threshold: i32,
-    /// The feature's index.
-    pub slot: u32,
-}
 
 /// The smallest and largest leaf value of the tree at `root` (compile time).
 const fn leaf_extremes(nodes: &[Node], root: u16) -> (i32, i32) {
@@ -398,6 +414,49 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 20_000);
+    }
+
+    /// The clamp of the per-cell copy moves no comparison: features at the i32
+    /// extremes and around the clamp's bounds score as the node walk does.
+    #[test]
+    fn extreme_features_score_as_the_node_table() {
+        let walk = |f: &[i32; FEATURES]| {
+            score(
+                &forest_trees::NODES,
+                &forest_trees::ROOTS,
+                forest_trees::BIAS,
+                f,
+            )
+        };
+        let extremes = [
+            i32::MIN,
+            i32::MIN + 1,
+            -FEATURE_LIMIT - 1,
+            -FEATURE_LIMIT,
+            -THRESHOLD_LIMIT,
+            -1,
+            0,
+            THRESHOLD_LIMIT,
+            FEATURE_LIMIT - 1,
+            FEATURE_LIMIT,
+            i32::MAX,
+        ];
+        let mut rand = super::super::xorshift32(0xC0FF_EE11);
+        for _ in 0..5_000 {
+            let mut f = [0i32; FEATURES];
+            for x in f.iter_mut() {
+                *x = if rand() % 2 == 0 {
+                    extremes[(rand() as usize) % extremes.len()]
+                } else {
+                    (rand() % 1024) as i32 - 512
+                };
+            }
+            assert_eq!(FLIGHT.score(&f), walk(&f), "{f:?}");
+        }
+        for &v in &extremes {
+            let f = [v; FEATURES];
+            assert_eq!(FLIGHT.score(&f), walk(&f), "{v}");
+        }
     }
 
     /// The early exit is exact: on random features, at floors around the score and
