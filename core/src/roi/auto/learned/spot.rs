@@ -291,6 +291,73 @@ fn spot_of(
     })
 }
 
+/// One sampled row of [`strongest_spots`]' search: what a centre that passed the first
+/// test ([`reject_below`]) needs to become a spot.
+struct Centres<'a> {
+    /// Column sums of DN² of the ring's and the hole's sampled rows, per sampled column.
+    ring_sq: &'a [u32],
+    core_sq: &'a [u32],
+    /// Frame column of centre 0; centre k is `RING_STRIDE_PX · k` to its right.
+    x0: usize,
+    /// Frame row of the centres.
+    y: usize,
+    floor: Floor,
+    shift: u32,
+}
+
+impl Centres<'_> {
+    /// Centre `k` with its DN sums (`s_inner` of the 3×3, `ring_sum` of the ring): its
+    /// DN² sums summed directly (the ring's 7 sampled columns less the hole's 3; the same
+    /// sums and wrapping arithmetic as sums run along the row), [`spot_of`], and the
+    /// spot offered to `list`, raising `admit16` when the list is full. Returns the
+    /// first test's new bound. Out of line: the search loop keeps its registers.
+    #[inline(never)]
+    fn consider(
+        &self,
+        list: &mut [Option<Spot>; SPOTS],
+        admit16: &mut u32,
+        k: usize,
+        s_inner: i32,
+        ring_sum: i32,
+    ) -> u32 {
+        let (rs, gs) = (RING_PX / 2 / RING_STRIDE_PX, HOLE_PX / 2 / RING_STRIDE_PX);
+        let sum_sq = |b: &[u32]| b.iter().fold(0u32, |s, &v| s.wrapping_add(v));
+        let (Some(rq), Some(gq)) = (
+            self.ring_sq.get(k..=k + 2 * rs),
+            self.core_sq.get(k + rs - gs..=k + rs + gs),
+        ) else {
+            return reject_below(*admit16, self.floor);
+        };
+        if let Some(s) = spot_of(
+            self.x0 + RING_STRIDE_PX * k,
+            self.y,
+            s_inner,
+            ring_sum,
+            sum_sq(rq).wrapping_sub(sum_sq(gq)),
+            self.floor,
+            *admit16,
+            self.shift,
+        ) {
+            offer(list, s);
+            if let Some(Some(last)) = list.last() {
+                *admit16 = (*admit16).max(last.z16.saturating_add(1));
+            }
+        }
+        reject_below(*admit16, self.floor)
+    }
+}
+
+/// The least |9 × 120 × (core mean − ring mean)| (`spot_of`'s `num`, under 2^23) that
+/// passes `spot_of`'s first test at `admit16`: `16 |num| < 9 admit16 floor.n` rejects,
+/// so this is ⌈9 admit16 floor.n / 16⌉, saturated at `u32::MAX` (which rejects every
+/// `num`, as the 64-bit test does then).
+fn reject_below(admit16: u32, floor: Floor) -> u32 {
+    let bound = (9 * u64::from(admit16))
+        .saturating_mul(floor.n)
+        .div_ceil(16);
+    u32::try_from(bound).unwrap_or(u32::MAX)
+}
+
 /// The spot at (x, y) from direct sums over its 13×13 square (`None` when the square
 /// leaves the window or z is under `admit16` / 16): the refinement's and the tests'
 /// reference.
@@ -367,11 +434,6 @@ fn offer(list: &mut [Option<Spot>; SPOTS], s: Spot) {
 /// The columns of `b` from `k` on (none when `k` is past its end).
 fn from(b: &[u32], k: usize) -> &[u32] {
     b.get(k..).unwrap_or(&[])
-}
-
-/// The columns of `b` from `from` on, in pairs (none when `from` is past its end).
-fn pairs(b: &[u32], from: usize) -> core::slice::ChunksExact<'_, u32> {
-    b.get(from..).unwrap_or(&[]).chunks_exact(2)
 }
 
 /// Strongest first, free places last (insertion sort of 5; stable).
@@ -479,7 +541,6 @@ pub(crate) fn strongest_spots(
         }
         // Sums of at most 40 sampled pixels of 12 bits: DN in i32, DN² in u32.
         let sum_dn = |b: &[u32]| b.iter().map(|&v| v as i32).sum::<i32>();
-        let sum_sq = |b: &[u32]| b.iter().fold(0u32, |s, &v| s.wrapping_add(v));
         let (Some(r0), Some(g0), Some(i0)) = (
             ring.dn.get(..=2 * rs),
             core.dn.get(rs - gs..=rs + gs),
@@ -487,65 +548,43 @@ pub(crate) fn strongest_spots(
         ) else {
             continue;
         };
-        let (Some(rq0), Some(gq0)) = (ring.sq.get(..=2 * rs), core.sq.get(rs - gs..=rs + gs))
-        else {
-            continue;
-        };
         let (mut s_ring, mut s_core, mut s_inner) = (sum_dn(r0), sum_dn(g0), sum_dn(i0));
-        let (mut q_ring, mut q_core) = (sum_sq(rq0), sum_sq(gq0));
-        // Each step one sampled column right (two pixels): the sampled columns entering
-        // and leaving the ring's and the hole's sums, the two pixel columns entering and
-        // leaving the core's (no index per read).
-        let steps = from(ring.dn, 2 * rs + 1)
-            .iter()
-            .zip(ring.dn.iter())
-            .zip(from(ring.sq, 2 * rs + 1).iter().zip(ring.sq.iter()))
-            .zip(
-                from(core.dn, rs + gs + 1)
-                    .iter()
-                    .zip(from(core.dn, rs - gs)),
-            )
-            .zip(
-                from(core.sq, rs + gs + 1)
-                    .iter()
-                    .zip(from(core.sq, rs - gs)),
-            )
-            .zip(pairs(inner, r + 2).zip(pairs(inner, r - 1)));
-        let mut c = r;
-        let mut step = None;
-        let mut steps = steps;
+        // Centre k (pixel column r + 2k of the window) moves the ring's and the hole's
+        // sums one sampled column right (the first column of a window leaves, its last
+        // enters) and the core's two pixel columns. Only the DN sums run along the row
+        // and a centre is dropped on them alone (`reject_below`), so the loop keeps its
+        // sums in registers; the few centres that pass go to `consider`.
+        let centres = Centres {
+            ring_sq: ring.sq,
+            core_sq: core.sq,
+            x0: win.x0 + r,
+            y: cy,
+            floor,
+            shift,
+        };
+        let mut steps = ring
+            .dn
+            .windows(2 * rs + 2)
+            .zip(from(core.dn, rs - gs).windows(2 * gs + 2))
+            .zip(from(inner, r - 1).windows(5).step_by(RING_STRIDE_PX));
+        let mut reject_below = reject_below(admit16, floor);
+        let mut k = 0usize;
         loop {
-            if let Some(((((rd, rq), cd), cq), id)) = step {
-                let ((&rd_in, &rd_out), (&rq_in, &rq_out)) = (rd, rq);
-                let ((&cd_in, &cd_out), (&cq_in, &cq_out)) = (cd, cq);
-                let (id_in, id_out): (&[u32], &[u32]) = id;
-                s_ring += rd_in as i32 - rd_out as i32;
-                q_ring = q_ring.wrapping_add(rq_in).wrapping_sub(rq_out);
-                s_core += cd_in as i32 - cd_out as i32;
-                q_core = q_core.wrapping_add(cq_in).wrapping_sub(cq_out);
-                s_inner += sum_dn(id_in) - sum_dn(id_out);
-                c += RING_STRIDE_PX;
-            }
             let ring_sum = s_ring - s_core;
-            if let Some(s) = spot_of(
-                win.x0 + c,
-                cy,
-                s_inner,
-                ring_sum,
-                q_ring.wrapping_sub(q_core),
-                floor,
-                admit16,
-                shift,
-            ) {
-                offer(&mut list, s);
-                if let Some(Some(last)) = list.last() {
-                    admit16 = admit16.max(last.z16.saturating_add(1));
-                }
+            // `spot_of`'s first test, on 32 bits: |num| < 2^23.
+            let num = RING_COUNT as i32 * s_inner - INNER_COUNT as i32 * ring_sum;
+            if num.unsigned_abs() >= reject_below {
+                reject_below = centres.consider(&mut list, &mut admit16, k, s_inner, ring_sum);
             }
-            step = steps.next();
-            if step.is_none() {
+            let Some(((&[rd_out, .., rd_in], &[cd_out, .., cd_in]), &[o0, o1, _, i0, i1])) =
+                steps.next()
+            else {
                 break;
-            }
+            };
+            s_ring += rd_in as i32 - rd_out as i32;
+            s_core += cd_in as i32 - cd_out as i32;
+            s_inner += (i0 as i32 + i1 as i32) - (o0 as i32 + o1 as i32);
+            k += 1;
         }
     }
     // Each spot to the strongest centre of its 3×3 (the grid's own first on a tie).
