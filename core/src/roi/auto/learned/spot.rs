@@ -299,15 +299,16 @@ impl Centres<'_> {
     /// DN² sums summed directly (the ring's 7 sampled columns less the hole's 3; the same
     /// sums and wrapping arithmetic as sums run along the row), [`spot_of`], and the
     /// spot offered to `list`, raising `admit16` when the list is full. Returns the
-    /// first test's new bound. Out of line: the search loop keeps its registers.
+    /// first test's bound: `reject_below` as it was, or recomputed when `admit16` rose.
+    /// Out of line: the search loop keeps its registers.
     #[inline(never)]
     fn consider(
         &self,
         list: &mut [Option<Spot>; SPOTS],
         admit16: &mut u32,
+        reject_below: u32,
         k: usize,
-        s_inner: i32,
-        ring_sum: i32,
+        (s_inner, ring_sum): (i32, i32),
     ) -> u32 {
         let (rs, gs) = (RING_PX / 2 / RING_STRIDE_PX, HOLE_PX / 2 / RING_STRIDE_PX);
         let sum_sq = |b: &[u32]| b.iter().fold(0u32, |s, &v| s.wrapping_add(v));
@@ -315,9 +316,9 @@ impl Centres<'_> {
             self.ring_sq.get(k..=k + 2 * rs),
             self.core_sq.get(k + rs - gs..=k + rs + gs),
         ) else {
-            return reject_below(*admit16, self.floor);
+            return reject_below;
         };
-        if let Some(s) = spot_of(
+        let Some(s) = spot_of(
             self.x0 + RING_STRIDE_PX * k,
             self.y,
             s_inner,
@@ -326,13 +327,17 @@ impl Centres<'_> {
             self.floor,
             *admit16,
             self.shift,
-        ) {
-            offer(list, s);
-            if let Some(Some(last)) = list.last() {
-                *admit16 = (*admit16).max(last.z16.saturating_add(1));
+        ) else {
+            return reject_below;
+        };
+        offer(list, s);
+        match list.last() {
+            Some(Some(last)) if last.z16.saturating_add(1) > *admit16 => {
+                *admit16 = last.z16.saturating_add(1);
+                self::reject_below(*admit16, self.floor)
             }
+            _ => reject_below,
         }
-        reject_below(*admit16, self.floor)
     }
 }
 
@@ -568,7 +573,8 @@ pub(crate) fn strongest_spots(
             // `spot_of`'s first test, on 32 bits: |num| < 2^23.
             let num = RING_COUNT as i32 * s_inner - INNER_COUNT as i32 * ring_sum;
             if num.unsigned_abs() >= reject_below {
-                reject_below = centres.consider(&mut list, &mut admit16, k, s_inner, ring_sum);
+                let sums = (s_inner, ring_sum);
+                reject_below = centres.consider(&mut list, &mut admit16, reject_below, k, sums);
             }
             let Some(((&[rd_out, .., rd_in], &[cd_out, .., cd_in]), &[o0, o1, _, i0, i1])) =
                 steps.next()
