@@ -116,11 +116,11 @@ const FEATURE_LIMIT: i32 = 1 << 30;
 /// table ([`FlatForest::build`]): each of the `T` trees as a complete binary tree of
 /// depth `D = log2 L` in 1-based heap order (the root at 1, the children of split `k` at
 /// `2k` and `2k + 1`; splits `1..L`, leaves `L..2L`). A leaf of the table above depth `D`
-/// becomes splits that always go left (they read [`ALWAYS_LEFT_SLOT`], 0, against a
+/// becomes splits that always go left (they read `ALWAYS_LEFT_SLOT`, 0, against a
 /// threshold of 0) down to a leaf holding its value, so every cell walks exactly `D`
 /// splits per tree: no leaf test, no data-dependent loop length, and every index is
 /// masked by `L − 1` (no bounds check). A split is one word, threshold and slot packed
-/// ([`SLOT_BITS`]), and a step is `k = 2k + sign(threshold − feature)`: on the M7 about
+/// (`SLOT_BITS`), and a step is `k = 2k + sign(threshold − feature)`: on the M7 about
 /// 7 instructions per level with no conditional execution. The trees are stored largest
 /// leaf first ([`FlatForest::score_reaching`]'s early exit); `build` proves that no
 /// partial sum leaves the i32 range, so the order changes no sum. Scores equal

@@ -30,13 +30,15 @@
 //! (152 B each): 1 664 B for 8 (1 040 B for session 47's 5), and a region's bit rows;
 //! `auto-v2`'s stack peak (12 440 B on the M7, `scripts/flight.sh`) lies elsewhere and
 //! did not move.
-//! Cost (Cortex-M7, `scripts/worst-case.sh`): at most 5.49 M instructions per 328×248
-//! window, 67 per pixel: per sampled row the bands (a row in and a row out, of DN and
-//! DN²) and the core's column sums; per centre of the search grid (every second pixel
-//! of every second row) running sums and a comparison, the variance only where the
-//! contrast passes the noise floor, the division and square root only for a centre
-//! that would enter the spots; then the [`SPOTS`] spots' 3×3 refinement, regions and
-//! forest.
+//! Cost (Cortex-M7): per sampled row each band moved down (a row in and a row out, of
+//! DN and DN², one band per pass) and the core's column sums; per centre of the search
+//! grid (every second pixel of every second row) the DN sums moved along the row and a
+//! comparison, the DN² sums and the variance only where the contrast passes the noise
+//! floor (`reject_below`), the division and square root only for a centre that would
+//! enter the spots; then the [`SPOTS`] spots' 3×3 refinement, regions and forest.
+//! Session 34 measured at most 5.49 M instructions per 328×248 window (67 per pixel);
+//! session 49's loops (both bands and the DN² sums carried along the row before) took
+//! 1.3 M off the flight demo's far and Tango frames, where the stage runs.
 
 use super::features::FrameLevels;
 use super::forest::{self, Node};
