@@ -912,6 +912,47 @@ mod tests {
     extern crate std;
     use std::vec::Vec;
 
+    /// The search's 32-bit first test (`reject_below`) drops exactly the centres
+    /// `spot_of`'s 64-bit test drops: on every |num| within 2 of the bound and on random
+    /// ones, over noise σ of 1–65 535 DN at every shift and least z from 3 to 2^24.
+    #[test]
+    fn the_32_bit_first_test_is_spot_ofs() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut dropped = 0u32;
+        for _ in 0..20_000 {
+            let sigma = 1 + (next() % 65_535) as u32;
+            let floor = floor_of(sigma, (next() % 5) as u32);
+            let admit16 = MIN_Z16 + (next() % (1 << (next() % 25))) as u32;
+            let bound = reject_below(admit16, floor);
+            let random = (next() % (1 << 23)) as u32;
+            for a in [
+                bound.saturating_sub(2),
+                bound.saturating_sub(1),
+                bound,
+                bound.saturating_add(1),
+                random,
+            ] {
+                let a = a.min((1 << 23) - 1);
+                let drops = 16 * u64::from(a) < 9 * u64::from(admit16) * floor.n;
+                assert_eq!(
+                    a < bound,
+                    drops,
+                    "a {a} admit16 {admit16} floor {}",
+                    floor.n
+                );
+                dropped += u32::from(drops);
+            }
+        }
+        // Both answers occur (of 100 000 tests).
+        assert!(dropped > 1_000 && dropped < 99_000, "{dropped}");
+    }
+
     /// A textured background (sums of xorshift noise at two scales) with an optional
     /// 5×4-px block `contrast` DN above it at (200, 120).
     fn textured(contrast: i32) -> Vec<u16> {
