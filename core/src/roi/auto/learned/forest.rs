@@ -120,8 +120,8 @@ const FEATURE_LIMIT: i32 = 1 << 30;
 /// threshold of 0) down to a leaf holding its value, so every cell walks exactly `D`
 /// splits per tree: no leaf test, no data-dependent loop length, and every index is
 /// masked by `L − 1` (no bounds check). A split is one word, threshold and slot packed
-/// (`SLOT_BITS`), and a step is `k = 2k + sign(threshold − feature)`: on the M7 about
-/// 7 instructions per level with no conditional execution. The trees are stored largest
+/// (`SLOT_BITS`), and a step is `k = 2k + sign(threshold − feature)`: on the M7 six
+/// instructions per level with no conditional execution. The trees are stored largest
 /// leaf first ([`FlatForest::score_reaching`]'s early exit); `build` proves that no
 /// partial sum leaves the i32 range, so the order changes no sum. Scores equal
 /// [`score`]'s over the same table, bit for bit (the same comparisons; tested on both

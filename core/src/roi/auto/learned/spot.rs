@@ -282,6 +282,12 @@ fn spot_of(
     })
 }
 
+/// Pixel columns the core's 3×3 spans over one step of the search, its first two
+/// leaving and its last two entering (the loop's pattern `[o0, o1, _, i0, i1]` assumes
+/// a 3-px core and a 2-px step).
+const CORE_STEP_PX: usize = INNER_PX + RING_STRIDE_PX;
+const _: () = assert!(INNER_PX == 3 && RING_STRIDE_PX == 2 && CORE_STEP_PX == 5);
+
 /// One sampled row of [`strongest_spots`]' search: what a centre that passed the first
 /// test ([`reject_below`]) needs to become a spot.
 struct Centres<'a> {
@@ -567,7 +573,11 @@ pub(crate) fn strongest_spots(
             .dn
             .windows(2 * rs + 2)
             .zip(from(core.dn, rs - gs).windows(2 * gs + 2))
-            .zip(from(inner, r - 1).windows(5).step_by(RING_STRIDE_PX));
+            .zip(
+                from(inner, r - 1)
+                    .windows(CORE_STEP_PX)
+                    .step_by(RING_STRIDE_PX),
+            );
         let mut reject_below = reject_below(admit16, floor);
         let mut k = 0usize;
         loop {
