@@ -5,11 +5,11 @@
 //! 1. **Seeds**, a cheap look at each 8×8 cell from the cell planes alone (no pixel
 //!    read, [`SeedRule::is_seed`]): a cell is a seed when it has an outline or a level of its
 //!    own: its largest two-pixel step reaches [`SEED_STEP_CODE_MIN`], its mean
-//!    differs from the mean of one of its context boxes (radii
-//!    [`super::features::RADII_CELLS`]) by at least [`SEED_CONTRAST_CODE_MIN`], or
-//!    its mean lies far out in the frame's range of cell means ([`SEED_LEVEL_MIN`]).
-//!    All three are the classifier's own features (feature 3, the magnitudes of
-//!    features 5, 9, 13 and 17, and of feature 0 of [`super::features`], computed here
+//!    differs from the mean of one of its nearest [`SEED_CONTRAST_RADII`] context
+//!    boxes (radii 1 and 2 cells of [`super::features::RADII_CELLS`]) by at least
+//!    [`SEED_CONTRAST_CODE_MIN`], or its mean lies far out in the frame's range of cell
+//!    means ([`SEED_LEVEL_MIN`]). All three are the classifier's own features (feature
+//!    3, the magnitudes of features 5 and 9, and of feature 0 of [`super::features`], computed here
 //!    the same way, bit for bit), so the rule can be checked on any feature dump
 //!    ([`is_seed_features`]). Every seed is classified.
 //! 2. **Growth**: every 8-neighbour of a target cell is classified too, until no new
@@ -32,10 +32,23 @@ use super::features::{FEATURES, FrameLevels, RADII_CELLS, log_code};
 /// the module's figures in `docs/detectors.md` § auto-v2.
 pub const SEED_STEP_CODE_MIN: i32 = 90;
 
-/// A cell whose mean differs from one of its context boxes' means by at least this
-/// [`log_code`] (of 4 · |difference| / σ; the magnitude of features 5, 9, 13, 17) is a
-/// seed. 70: a contrast of about 5 σ (`log_code(21) = 70`).
+/// A cell whose mean differs from one of its nearest [`SEED_CONTRAST_RADII`] context
+/// boxes' means by at least this [`log_code`] (of 4 · |difference| / σ; the magnitude
+/// of features 5 and 9) is a seed. 70: a contrast of about 5 σ (`log_code(21) = 70`).
 pub const SEED_CONTRAST_CODE_MIN: i32 = 70;
+
+/// Context boxes the contrast test looks at: the first 2 of
+/// [`super::features::RADII_CELLS`] (1 and 2 cells: 24 and 40 px across). Chosen in
+/// session 49 for the M7 budget: until then the 4- and 8-cell boxes seeded too, and on
+/// textured Earth a cloud field's cells differ from a 72- or 136-px box's mean by 5 σ
+/// (those radii alone seeded 10 % of famA's cells and 15 % of paper A's, with under
+/// 1 % of their target cells, which a target's outline or a near contrast seeds as
+/// well). Family A (½; the sum of famA, paper A, fixtures A and famAF) 2.4261 →
+/// 2.4261, false alarms unchanged, held out +0.0001; M7 `auto-v2` mean 6.54 → 4.94 M.
+/// Without the level test too: 4.39 M but family A 2.4256, held out −0.003 — not
+/// taken (`docs/detectors.md` § Session 49).
+pub const SEED_CONTRAST_RADII: usize = 2;
+const _: () = assert!(SEED_CONTRAST_RADII <= RADII_CELLS.len());
 
 /// A cell whose mean lies at least this far from the median of the frame's cell means,
 /// in 1/256 of the frame's range (p98 − p2, at least σ; the magnitude of feature 0), is
@@ -134,7 +147,7 @@ impl SeedRule {
         // ⌊s/n⌋ ≥ m + t ⇔ s ≥ (m + t)·n; ⌊s/n⌋ ≤ m − t ⇔ s < (m − t + 1)·n.
         let above = (m + self.contrast_dn).min(ABOVE_ANY_MEAN);
         let below = m.checked_sub(self.contrast_dn);
-        for &r in RADII_CELLS.iter() {
+        for &r in RADII_CELLS.iter().take(SEED_CONTRAST_RADII) {
             let (x0, y0) = (cx.saturating_sub(r), cy.saturating_sub(r));
             let (x1, y1) = (
                 (cx + r).min(pw.saturating_sub(1)),
@@ -153,14 +166,15 @@ impl SeedRule {
     }
 }
 
-/// [`SeedRule::is_seed`] on a cell's feature vector ([`super::features::cell_features`]): feature
-/// 3 against [`SEED_STEP_CODE_MIN`], the magnitudes of features 5, 9, 13, 17 against
-/// [`SEED_CONTRAST_CODE_MIN`] and of feature 0 against [`SEED_LEVEL_MIN`]. The same decision as [`SeedRule::is_seed`] on the planes (tested),
-/// for checks on feature dumps.
+/// [`SeedRule::is_seed`] on a cell's feature vector ([`super::features::cell_features`]):
+/// feature 3 against [`SEED_STEP_CODE_MIN`], the magnitudes of features 5 and 9 (the
+/// first [`SEED_CONTRAST_RADII`] context boxes) against [`SEED_CONTRAST_CODE_MIN`] and
+/// of feature 0 against [`SEED_LEVEL_MIN`]. The same decision as [`SeedRule::is_seed`]
+/// on the planes (tested), for checks on feature dumps.
 pub fn is_seed_features(f: &[i32; FEATURES]) -> bool {
     f[3] >= SEED_STEP_CODE_MIN
         || f[0].abs() >= SEED_LEVEL_MIN
-        || (0..RADII_CELLS.len()).any(|k| f[5 + 4 * k].abs() >= SEED_CONTRAST_CODE_MIN)
+        || (0..SEED_CONTRAST_RADII).any(|k| f[5 + 4 * k].abs() >= SEED_CONTRAST_CODE_MIN)
 }
 
 /// The cascade over a `pw × ph` plane (see the module): `codes[i]` ends as
@@ -432,7 +446,7 @@ mod tests {
                     let m = i64::from(mean_dn[cy * pw + cx]);
                     let level = ((m - i64::from(p50)) * 256 / range).clamp(-4096, 4096);
                     let mut want = level.abs() >= i64::from(SEED_LEVEL_MIN);
-                    for &r in RADII_CELLS.iter() {
+                    for &r in RADII_CELLS.iter().take(SEED_CONTRAST_RADII) {
                         let (mut total, mut n) = (0i64, 0i64);
                         for y in cy.saturating_sub(r)..=(cy + r).min(ph - 1) {
                             for x in cx.saturating_sub(r)..=(cx + r).min(pw - 1) {
