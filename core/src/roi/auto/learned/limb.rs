@@ -26,6 +26,17 @@ const MAX_FRAME_SHARE_DIVISOR: usize = 4;
 /// their boxes 39–97 % saturated; the limb's were 0–1 %).
 const SATURATED_SHARE_DIVISOR: u32 = 10;
 
+/// How far, px, the region must go on behind a boundary pixel and the other level
+/// beyond it, within the box, for the pixel to count (3): a hot pixel in the deep sky
+/// or a cluster of cold pixels on the Earth's side (the real camera's hot pixels, the
+/// renderer's small cold elements, 1–3 px across) is no boundary of the limb. Without
+/// it a few such specks 30–60 px off the arc broke the fit (session 50: the deep sky
+/// in a corner of an Earth-filled frame, `famAS/000080`, boxed by a retrained forest:
+/// 11 px rms with them, 0.2 px without); the boundary of a half-plane or of a disc of
+/// 700 px radius passes whatever the slant (bar its pixels within 2 px of the box's
+/// sides), a U-shaped outline's sides and corners too, so a target's still fails.
+const BOUNDARY_DEPTH_PX: usize = 3;
+
 /// Fewest boundary pixels for a fit: fewer is a speck, not an arc.
 const MIN_BOUNDARY_PX: u32 = 8;
 
@@ -40,7 +51,8 @@ pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 /// 3 px on a side, at least a tenth saturated, with fewer than [`MIN_BOUNDARY_PX`]
 /// boundary pixels, or whose boundary is not an arc. Four passes over the box (about
 /// 8 pixel reads per pixel: range, histogram, region, and each region pixel's four
-/// neighbours); 1 KiB of stack (the histogram).
+/// neighbours, 2·[`BOUNDARY_DEPTH_PX`] more where one is of the other level); 1 KiB
+/// of stack (the histogram).
 pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
     let (w, h) = (frame.width(), frame.height());
     let (x0, y0, x1, y1) = (
@@ -85,7 +97,9 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
     let Some(t_bin) = otsu_bin(&hist) else {
         return false;
     };
-    let above = |v: u16| bin(v) > t_bin;
+    // `bin(v) > t_bin` as one comparison: (v − lo)·256 / span ≥ t_bin + 1.
+    let above_dn = u32::from(lo) + ((t_bin as u32 + 1) * span).div_ceil(OTSU_BINS as u32);
+    let above = |v: u16| u32::from(v) >= above_dn;
     // The region is the level the border sides of the box mostly show.
     let mut border = [0u32; 2];
     let mut count = |v: u16| border[usize::from(above(v))] += 1;
@@ -101,36 +115,46 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
         }
     }
     let region_above = border[1] >= border[0];
-    let inside = |v: u16| above(v) == region_above;
-    // Pass 3: the boundary pixels (in the region, a 4-neighbour in the box not) and
-    // the sums of two parabola fits, y on x and x on y (pixel centres from the box's
-    // centre, px; exact in f64).
+    // Whether the box's pixel (x, y) is in the region; `None` outside the box.
+    let pixels = frame.pixels();
+    let inside = |x: isize, y: isize| -> Option<bool> {
+        let (x, y) = (usize::try_from(x).ok()?, usize::try_from(y).ok()?);
+        if !(x0..x1).contains(&x) || !(y0..y1).contains(&y) {
+            return None;
+        }
+        pixels.get(y * w + x).map(|&v| above(v) == region_above)
+    };
+    // Pass 3: the boundary pixels (in the region, a 4-neighbour in the box not, with
+    // the region behind it and the other level beyond for [`BOUNDARY_DEPTH_PX`] each
+    // way, all in the box) and the sums of two parabola fits, y on x and x on y (pixel centres from
+    // the box's centre, px; exact in f64).
+    let depth = BOUNDARY_DEPTH_PX as isize;
+    let crosses = |x: isize, y: isize, dx: isize, dy: isize| {
+        inside(x + dx, y + dy) == Some(false)
+            && (1..depth).all(|k| {
+                inside(x - k * dx, y - k * dy) == Some(true)
+                    && inside(x + (k + 1) * dx, y + (k + 1) * dy) == Some(false)
+            })
+    };
     let from_centre = |a: usize, lo: usize, hi: usize| a as f64 + 0.5 - (lo + hi) as f64 / 2.0;
     let mut fit_x = ParabolaSums::default();
     let mut fit_y = ParabolaSums::default();
-    let mut prev: Option<&[u16]> = None;
-    let mut it = (y0..y1).zip(rows()).peekable();
-    while let Some((y, row)) = it.next() {
-        let next = it.peek().map(|&(_, r)| r);
-        for (i, &v) in row.iter().enumerate() {
-            if !inside(v) {
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (xi, yi) = (x as isize, y as isize);
+            if inside(xi, yi) != Some(true) {
                 continue;
             }
-            let out = |r: Option<&[u16]>, k: Option<usize>| {
-                k.and_then(|k| r.and_then(|r| r.get(k)))
-                    .is_some_and(|&q| !inside(q))
-            };
-            let boundary = out(Some(row), i.checked_sub(1))
-                || out(Some(row), Some(i + 1))
-                || out(prev, Some(i))
-                || out(next, Some(i));
+            let boundary = crosses(xi, yi, -1, 0)
+                || crosses(xi, yi, 1, 0)
+                || crosses(xi, yi, 0, -1)
+                || crosses(xi, yi, 0, 1);
             if boundary {
-                let (u, v) = (from_centre(x0 + i, x0, x1), from_centre(y, y0, y1));
+                let (u, v) = (from_centre(x, x0, x1), from_centre(y, y0, y1));
                 fit_x.add(u, v);
                 fit_y.add(v, u);
             }
         }
-        prev = Some(row);
     }
     if fit_x.n < f64::from(MIN_BOUNDARY_PX) {
         return false;
@@ -270,6 +294,34 @@ mod tests {
         let px = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
         let f = Frame::new(&px, W, H, 14).unwrap();
         assert!(is_limb(&f, roi(0, 0, 30, 120)));
+    }
+
+    #[test]
+    fn specks_off_the_arc_do_not_break_it() {
+        // The deep sky in the top-right corner of an Earth-filled frame (the region is
+        // the darker level), with the real camera's specks: hot pixels in the sky and
+        // clusters of cold pixels on the Earth 20–60 px off the arc. Each of them alone
+        // would put boundary pixels far from the parabola.
+        let (cx, cy, r) = (160.0 - 480.0, 120.0 + 480.0, 700.0);
+        let mut px = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
+        let mut set = |x: usize, y: usize, v: u16| px[y * W + x] = v;
+        for &(x, y) in &[(150, 3), (140, 10), (155, 20)] {
+            set(x, y, 6000); // hot pixels in the deep sky
+        }
+        for &(x, y) in &[(104, 45), (120, 48), (130, 46), (108, 30)] {
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                set(x + dx, y + dy, 1000); // 2 × 2 cold specks on the Earth
+            }
+        }
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        let b = roi(100, 0, 160, 50);
+        assert!(is_limb(&f, b));
+        // The same box without the arc (a square of sky in the corner, specks and all)
+        // still fails: its outline has a corner.
+        let mut sq = frame_of(|x, y| !(x > 125.0 && y < 25.0));
+        sq[3 * W + 150] = 6000;
+        let g = Frame::new(&sq, W, H, 14).unwrap();
+        assert!(!is_limb(&g, roi(100, 0, 160, 50)));
     }
 
     #[test]
