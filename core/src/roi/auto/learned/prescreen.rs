@@ -52,9 +52,16 @@ const _: () = assert!(SEED_CONTRAST_RADII <= RADII_CELLS.len());
 
 /// A cell whose mean lies at least this far from the median of the frame's cell means,
 /// in 1/256 of the frame's range (p98 − p2, at least σ; the magnitude of feature 0), is
-/// a seed: 96, three eighths of the range (a target near the dark or the bright end of
-/// the frame, whatever its surroundings).
-pub const SEED_LEVEL_MIN: i32 = 96;
+/// a seed: 128, half the range (a target near the dark or the bright end of the
+/// frame, whatever its surroundings). Session 50, for the M7 budget: at 96 (three
+/// eighths, until then) a textured Earth's cold and warm cloud cells seeded by their
+/// level alone — 13.7 % of famA's cells, 6.3 % at 128 (all seeds 24.4 → 17.1 %;
+/// paper A 16.0 → 10.8 %), while a target's cells are reached from its outline.
+/// Family A (½; famA + paper A + fixtures A + famAF) 2.4261 → 2.4260 (one famAF frame
+/// at IoU 0.06 lost), false alarms unchanged, famAS tracked 0.5649 → 0.5646; held
+/// out −0.0030 (one paper B frame boxed in part); M7 `auto-v2` mean 4.94 → 4.71 M.
+/// 160 and 192 lose famA −0.0004 (as no level seed at all).
+pub const SEED_LEVEL_MIN: i32 = 128;
 
 /// The least `q` whose [`log_code`] reaches [`SEED_CONTRAST_CODE_MIN`] (21: a contrast
 /// of 5.25 σ): the contrast test as `4 · |m − mean| / σ ≥ q`, without the log.
@@ -77,7 +84,7 @@ pub struct SeedRule {
     /// The frame's median cell mean, DN (feature 0's origin).
     p50: u64,
     /// `SEED_LEVEL_MIN · max(p98 − p2, σ)`: a cell is a level seed when `256 · |m − p50|`
-    /// reaches it (feature 0 rounds toward zero, so `|level| ≥ 96` exactly then).
+    /// reaches it (feature 0 rounds toward zero, so `|level| ≥ SEED_LEVEL_MIN` exactly then).
     level_x256: u64,
     /// `⌈SEED_CONTRAST_Q_MIN · σ / 4⌉`, DN: a cell is a contrast seed when its mean and a
     /// context box's (rounded down, as feature 5 + 4k takes it) differ by at least this
