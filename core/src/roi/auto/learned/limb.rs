@@ -8,7 +8,9 @@
 //! the test stays narrow: a box on the frame's border, at most a quarter of the frame,
 //! hardly saturated (a saturated target's face cut by the frame is straight too,
 //! family A's detection frames), whose boundary between its two levels (Otsu inside
-//! the box) follows a parabola within [`MAX_ARC_RMS2_PX2`].
+//! the box) follows a parabola within [`MAX_ARC_RMS2_PX2`]. A boundary pixel counts
+//! only with 3 px of its level behind it and of the other level beyond (session 50), so
+//! hot pixels and cold specks off the arc do not break the fit.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -51,7 +53,7 @@ pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 /// 3 px on a side, at least a tenth saturated, with fewer than [`MIN_BOUNDARY_PX`]
 /// boundary pixels, or whose boundary is not an arc. Four passes over the box (about
 /// 8 pixel reads per pixel: range, histogram, region, and each region pixel's four
-/// neighbours, 2·[`BOUNDARY_DEPTH_PX`] more where one is of the other level); 1 KiB
+/// neighbours, 2·`BOUNDARY_DEPTH_PX` more where one is of the other level); 1 KiB
 /// of stack (the histogram).
 pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
     let (w, h) = (frame.width(), frame.height());
