@@ -243,6 +243,64 @@ fn stats_tool_reproduces_the_real_image_readme() {
     let [small, mid] = s.cold_features_per_10k_px;
     assert!((2.3..=2.9).contains(&small), "small cold features {small}");
     assert!((0.3..=0.7).contains(&mid), "mid cold features {mid}");
+    // Cold structures (session 50), measured independently with scipy / numpy
+    // (`ndimage.label` 8-connected on BT ≤ p90 − 10 K, `np.cov` of each group's pixel
+    // coordinates): 20 groups of at least 200 px, 0.875 per 10⁴ valid px, 5 of them bands.
+    let [per_10k, bands] = s.cold_structures;
+    assert!((per_10k - 0.875).abs() < 0.005, "cold structures {per_10k}");
+    assert!((bands - 0.25).abs() < 1e-9, "bands {bands}");
+}
+
+/// Sets the `bw × bh` block at (`x0`, `y0`) of the row-major image `t` (`w` wide) to
+/// `t_k`.
+fn paint(t: &mut [f64], w: usize, (x0, y0, bw, bh): (usize, usize, usize, usize), t_k: f64) {
+    for y in y0..y0 + bh {
+        t[y * w + x0..y * w + x0 + bw].fill(t_k);
+    }
+}
+
+/// The cold-structure count and band share against a drawn image: a 300 K field of
+/// 200 × 200 px (the warm reference given) with, 30 K colder, a 10 × 80 band (elongation
+/// about 8), a 25 × 10 block (2.5: no band), a disc of radius 12 (about 1) and a
+/// 10 × 10 square (100 px: too small), and a 20 × 20 square only 5 K colder (no cloud
+/// top).
+#[test]
+fn cold_structures_count_masses_and_bands() {
+    use tirroi_host::world::earth::texture_stats::cold_structures;
+    let (w, h) = (200, 200);
+    let mut t = vec![300.0; w * h];
+    paint(&mut t, w, (10, 10, 10, 80), 270.0);
+    paint(&mut t, w, (40, 10, 25, 10), 270.0);
+    paint(&mut t, w, (150, 150, 10, 10), 270.0);
+    paint(&mut t, w, (100, 20, 20, 20), 295.0);
+    for y in 0..h {
+        for x in 0..w {
+            if (x as f64 - 100.0).hypot(y as f64 - 120.0) <= 12.0 {
+                t[y * w + x] = 270.0;
+            }
+        }
+    }
+    let [per_10k, bands] = cold_structures(&t, w, h, 300.0);
+    assert!(
+        (per_10k - 3.0 * 1e4 / (w * h) as f64).abs() < 1e-9,
+        "{per_10k}"
+    );
+    assert!((bands - 1.0 / 3.0).abs() < 1e-9, "{bands}");
+    // No data is not cold: a row of NaN across the band splits it into two
+    // groups of 10 × 40 and 10 × 39 px (each a band), and leaves the count's base.
+    let mut cut = t.clone();
+    cut[50 * w + 10..50 * w + 20].fill(f64::NAN);
+    let [per_10k, bands] = cold_structures(&cut, w, h, 300.0);
+    assert!(
+        (per_10k - 4.0 * 1e4 / (w * h - 10) as f64).abs() < 1e-9,
+        "{per_10k}"
+    );
+    assert!((bands - 0.5).abs() < 1e-9, "{bands}");
+    // Without any structure the share is undefined.
+    let flat = vec![300.0; w * h];
+    let [n, share] = cold_structures(&flat, w, h, 300.0);
+    assert_eq!(n, 0.0);
+    assert!(share.is_nan());
 }
 
 /// The cold-feature count against a brute-force reference on a drawn image: a flat
@@ -253,17 +311,10 @@ fn cold_features_count_small_and_mid_elements() {
     use tirroi_host::world::earth::texture_stats::cold_features;
     let (w, h) = (64, 64);
     let mut t = vec![280.0; w * h];
-    let mut paint = |x0: usize, y0: usize, bw: usize, bh: usize, dt: f64| {
-        for y in y0..y0 + bh {
-            for x in x0..x0 + bw {
-                t[y * w + x] = 280.0 - dt;
-            }
-        }
-    };
-    paint(5, 5, 1, 1, 25.0);
-    paint(20, 5, 3, 3, 25.0);
-    paint(40, 30, 6, 5, 25.0);
-    paint(10, 40, 3, 3, 10.0);
+    paint(&mut t, w, (5, 5, 1, 1), 255.0);
+    paint(&mut t, w, (20, 5, 3, 3), 255.0);
+    paint(&mut t, w, (40, 30, 6, 5), 255.0);
+    paint(&mut t, w, (10, 40, 3, 3), 270.0);
     let [small, mid] = cold_features(&t, w, h);
     let per = 1e4 / (w * h) as f64;
     assert!((small - 2.0 * per).abs() < 1e-9, "{small}");

@@ -61,7 +61,7 @@ pub fn builtin_field(seed: u64, day: u64) -> CloudField {
 
 fn row(name: &str, s: &TextureStats) -> String {
     format!(
-        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} |",
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} | {:.2}, {:.0} |",
         s.step2_k[0],
         s.step2_k[1],
         s.step2_k[2],
@@ -80,6 +80,8 @@ fn row(name: &str, s: &TextureStats) -> String {
         s.cloud_top_sd_k[0],
         s.cloud_top_sd_k[1],
         100.0 * s.intermediate_share,
+        s.cold_structures[0],
+        100.0 * s.cold_structures[1],
     )
 }
 
@@ -119,9 +121,9 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(
-            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % |"
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % | cold structures ≥ 200 px per 10⁴ px, bands % |"
         );
-        println!("|---|---|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|---|");
         for day in 0..args.days {
             let field = texture(day);
             for &(lat, lon) in &PATCH_CENTRES {

@@ -45,6 +45,16 @@ pub const CLOUD_TOP_WINDOW_PX: usize = 5;
 /// The band of intermediate levels below the warm reference, K: thin cloud, cloud
 /// fringes and mixed pixels, neither clear surface nor cloud top.
 pub const INTERMEDIATE_BAND_K: (f64, f64) = (2.0, 15.0);
+/// Least size of a cold structure, px (200 px at 4 km: 3 200 km², about 14 px across):
+/// a cloud mass or band at the scale of the camera's frame, large enough to fill
+/// several of `auto-v2`'s 8-px cells beside a target and to be cut by the frame's
+/// side as a body is (session 50: such masses were a retrained cell forest's false
+/// alarms on the real Earth).
+pub const COLD_STRUCTURE_MIN_PX: usize = 200;
+/// A cold structure is a band when its pixels' spread along their main axis is at
+/// least this many times the spread across (the square root of the ratio of the
+/// coordinates' covariance eigenvalues; a uniform L × W rectangle gives about L / W).
+pub const BAND_ELONGATION: f64 = 3.0;
 
 /// Statistics of one image (see the README's table).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,6 +79,11 @@ pub struct TextureStats {
     /// Share of the valid pixels in [`INTERMEDIATE_BAND_K`] below the warm reference
     /// (0..=1): how much of the scene lies between the clear surface and the cloud tops.
     pub intermediate_share: f64,
+    /// Cold structures: 8-connected groups of at least [`COLD_STRUCTURE_MIN_PX`] valid
+    /// pixels each at least [`CLOUD_TOP_DEPTH_K`] below the warm reference, per 10⁴
+    /// valid pixels, and the share of them that are bands ([`BAND_ELONGATION`];
+    /// 0..=1, NaN without a structure).
+    pub cold_structures: [f64; 2],
     /// Number of 2-px steps measured.
     pub steps: usize,
 }
@@ -131,6 +146,7 @@ impl TextureStats {
                 })
                 .count() as f64
                 / bt.len() as f64,
+            cold_structures: cold_structures(t_k, w, h, warm_k),
             steps: steps.len(),
         })
     }
@@ -199,35 +215,83 @@ pub fn cold_features(t_k: &[f64], w: usize, h: usize) -> [f64; 2] {
         }
     }
     let mut counts = [0usize; 2];
+    for_each_group(&mut cold, w, h, |group| {
+        if group.len() <= SMALL_FEATURE_MAX_PX {
+            counts[0] += 1;
+        } else if group.len() <= MID_FEATURE_MAX_PX {
+            counts[1] += 1;
+        }
+    });
+    let per = 1e4 / valid.max(1) as f64;
+    [counts[0] as f64 * per, counts[1] as f64 * per]
+}
+
+/// Each 8-connected group of the `true` pixels of the row-major `w` × `h` `mask`, as
+/// its pixel indices (flood fill; the mask is cleared as the groups are taken).
+fn for_each_group(mask: &mut [bool], w: usize, h: usize, mut each: impl FnMut(&[usize])) {
     let mut stack = Vec::new();
-    for start in 0..w * h {
-        if !cold[start] {
+    let mut group = Vec::new();
+    for start in 0..(w * h).min(mask.len()) {
+        if !mask[start] {
             continue;
         }
-        cold[start] = false;
+        mask[start] = false;
         stack.push(start);
-        let mut size = 0usize;
+        group.clear();
         while let Some(i) = stack.pop() {
-            size += 1;
+            group.push(i);
             let (x, y) = (i % w, i / w);
             for yy in y.saturating_sub(1)..(y + 2).min(h) {
                 for xx in x.saturating_sub(1)..(x + 2).min(w) {
                     let j = yy * w + xx;
-                    if cold[j] {
-                        cold[j] = false;
+                    if mask[j] {
+                        mask[j] = false;
                         stack.push(j);
                     }
                 }
             }
         }
-        if size <= SMALL_FEATURE_MAX_PX {
-            counts[0] += 1;
-        } else if size <= MID_FEATURE_MAX_PX {
-            counts[1] += 1;
-        }
+        each(&group);
     }
-    let per = 1e4 / valid.max(1) as f64;
-    [counts[0] as f64 * per, counts[1] as f64 * per]
+}
+
+/// Cold structures of the row-major `w` × `h` image `t_k` (K, NaN = no data) with
+/// warm reference `warm_k`: per 10⁴ valid pixels, and the share of bands (see
+/// [`TextureStats::cold_structures`]).
+pub fn cold_structures(t_k: &[f64], w: usize, h: usize, warm_k: f64) -> [f64; 2] {
+    let top = warm_k - CLOUD_TOP_DEPTH_K;
+    let valid = t_k.iter().filter(|t| t.is_finite()).count();
+    // NaN compares false: no data is never cold.
+    let mut cold: Vec<bool> = t_k.iter().map(|&t| t <= top).collect();
+    let (mut structures, mut bands) = (0usize, 0usize);
+    for_each_group(&mut cold, w, h, |group| {
+        if group.len() < COLD_STRUCTURE_MIN_PX {
+            return;
+        }
+        structures += 1;
+        // The coordinates' covariance and its eigenvalues (a symmetric 2 × 2).
+        let n = group.len() as f64;
+        let (mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for &i in group {
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            (sx, sy) = (sx + x, sy + y);
+            (sxx, syy, sxy) = (sxx + x * x, syy + y * y, sxy + x * y);
+        }
+        let (mx, my) = (sx / n, sy / n);
+        let (cxx, cyy, cxy) = (sxx / n - mx * mx, syy / n - my * my, sxy / n - mx * my);
+        let half_trace = 0.5 * (cxx + cyy);
+        let root = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
+        let (major, minor) = (half_trace + root, (half_trace - root).max(1e-12));
+        if (major / minor).sqrt() >= BAND_ELONGATION {
+            bands += 1;
+        }
+    });
+    let share = if structures == 0 {
+        f64::NAN
+    } else {
+        bands as f64 / structures as f64
+    };
+    [structures as f64 * 1e4 / valid.max(1) as f64, share]
 }
 
 /// Slope of log power vs log frequency of the 2-D ring-averaged power spectrum of the
