@@ -26,7 +26,7 @@
 //! counting passes over the ring, no sort, no copy).
 
 use super::cells::{CELL_PX, cell_plane};
-use super::order::select;
+use super::order::select_binned;
 use crate::frame::Frame;
 use crate::roi::Roi;
 use crate::roi::plane::Window;
@@ -160,8 +160,8 @@ fn background(
     if n == 0 {
         return None;
     }
-    let level = select(ring, n / 2, u32::from(u16::MAX));
-    let mad = select(
+    let level = select_binned(ring, n / 2, u32::from(u16::MAX));
+    let mad = select_binned(
         || ring().map(|v| v.abs_diff(level)),
         n / 2,
         u32::from(u16::MAX),

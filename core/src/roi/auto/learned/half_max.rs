@@ -17,7 +17,7 @@
 //! just outside holds under half of its inward neighbour, so the faces' outline is
 //! cut where a uniform face's half height is, as before.
 
-use super::order::select;
+use super::order::select_binned;
 use crate::frame::Frame;
 use crate::roi::Roi;
 
@@ -89,7 +89,7 @@ fn ring_median(frame: &Frame<'_>, roi: Roi) -> Option<u16> {
     }
     let ring = buf.get(..n).filter(|r| !r.is_empty())?;
     // The element at index n/2 of the sorted ring.
-    let median = select(
+    let median = select_binned(
         || ring.iter().map(|&v| u32::from(v)),
         n / 2,
         u32::from(u16::MAX),

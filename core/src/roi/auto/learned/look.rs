@@ -52,7 +52,13 @@ fn mean_dn(frame: &Frame<'_>, r: Roi) -> Option<(u16, u64)> {
     for y in r.y0..r.y1 {
         let row = frame.row(usize::from(y))?;
         let row = row.get(usize::from(r.x0)..usize::from(r.x1))?;
-        sum += row.iter().map(|&v| u64::from(v.min(max_dn))).sum::<u64>();
+        // A row's sum in 32 bits (one add per pixel on the M7, not two): a frame is at
+        // most `MAX_FRAME_SIDE` (65 534) px wide, so the sum stays under 65 535² < 2³²
+        // and never wraps.
+        let row_sum = row
+            .iter()
+            .fold(0u32, |s, &v| s.wrapping_add(u32::from(v.min(max_dn))));
+        sum += u64::from(row_sum);
     }
     let n = u64::from(r.area());
     // `checked_div`: an empty box has no mean (and the flight build no panic path).
@@ -226,6 +232,22 @@ mod tests {
         // No strip (the whole frame) and nothing inside: no look.
         assert_eq!(Look::measure(&f, Roi::new(0, 0, 32, 24)), None);
         assert_eq!(Look::measure(&f, Roi::new(40, 40, 50, 50)), None);
+    }
+
+    /// The widest frame's full-width box, every pixel at the top DN: its rows' 32-bit
+    /// sums (65 534 × 65 535) do not wrap, so its level is the top DN; the strip below,
+    /// at half the level, gives its own.
+    #[test]
+    fn the_widest_box_at_the_top_dn_keeps_its_level() {
+        extern crate std;
+        const W: usize = crate::frame::MAX_FRAME_SIDE;
+        let mut px = std::vec![u16::MAX; W * 3];
+        px[2 * W..].fill(u16::MAX / 2);
+        let f = Frame::new(&px, W, 3, 16).expect("a valid frame");
+        let wide = Look::measure(&f, Roi::new(0, 0, W as u16, 2)).expect("a look");
+        assert_eq!(wide.level_dn, u16::MAX);
+        assert_eq!(wide.side_dn[1], Some(u16::MAX / 2));
+        assert_eq!(wide.ring_dn, u16::MAX / 2);
     }
 
     /// The same place matches itself; background, the other sign, a halved or
