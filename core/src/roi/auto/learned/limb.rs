@@ -128,8 +128,8 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
     };
     // Pass 3: the boundary pixels (in the region, a 4-neighbour in the box not, with
     // the region behind it and the other level beyond for [`BOUNDARY_DEPTH_PX`] each
-    // way, all in the box) and the sums of two parabola fits, y on x and x on y (pixel centres from
-    // the box's centre, px; exact in f64).
+    // way, all in the box) and the sums of two parabola fits, y on x and x on y
+    // (pixel centres from the box's centre, px; exact in f64).
     let depth = BOUNDARY_DEPTH_PX as isize;
     let crosses = |x: isize, y: isize, dx: isize, dy: isize| {
         inside(x + dx, y + dy) == Some(false)

@@ -1,9 +1,10 @@
 //! Order statistics without a sort or a copy: the element of index `k` of values
 //! that can be read again (a closure giving a fresh iterator), by counting passes over
 //! the value range ([`select_binned`], 64 bins a pass, what the stages use; [`select`],
-//! bisection, its reference). Core's sort keeps a panic path (its order-violation check) that the
-//! panic-never check flags, and the stages that need a median (the body stage's
-//! ring of cells, the half-maximum cut's ring of pixels) hold no buffer to sort.
+//! bisection, its reference). Core's sort keeps a panic path (its order-violation
+//! check) that the panic-never check flags, and the stages that need a median (the
+//! body stage's ring of cells, the half-maximum cut's ring of pixels) hold no buffer
+//! to sort.
 
 /// The smallest `v` in `0..=hi` with more than `k` of `values()` at most `v` (the
 /// element of index `k` of the sorted values), by bisection: no sort, no copy.
