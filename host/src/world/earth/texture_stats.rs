@@ -227,11 +227,13 @@ pub fn cold_features(t_k: &[f64], w: usize, h: usize) -> [f64; 2] {
 }
 
 /// Each 8-connected group of the `true` pixels of the row-major `w` × `h` `mask`, as
-/// its pixel indices (flood fill; the mask is cleared as the groups are taken).
+/// its pixel indices (flood fill; the mask is cleared as the groups are taken). The
+/// callers build `mask` with `w × h` entries.
 fn for_each_group(mask: &mut [bool], w: usize, h: usize, mut each: impl FnMut(&[usize])) {
+    debug_assert_eq!(mask.len(), w * h);
     let mut stack = Vec::new();
     let mut group = Vec::new();
-    for start in 0..(w * h).min(mask.len()) {
+    for start in 0..mask.len() {
         if !mask[start] {
             continue;
         }

@@ -3,15 +3,15 @@
 //!
 //! Two steps ([`cascade`]):
 //! 1. **Seeds**, a cheap look at each 8×8 cell from the cell planes alone (no pixel
-//!    read, [`SeedRule::is_seed`]): a cell is a seed when it has an outline or a level of its
-//!    own: its largest two-pixel step reaches [`SEED_STEP_CODE_MIN`], its mean
+//!    read, [`SeedRule::is_seed`]): a cell is a seed when it has an outline or a level
+//!    of its own: its largest two-pixel step reaches [`SEED_STEP_CODE_MIN`], its mean
 //!    differs from the mean of one of its nearest [`SEED_CONTRAST_RADII`] context
 //!    boxes (radii 1 and 2 cells of [`super::features::RADII_CELLS`]) by at least
 //!    [`SEED_CONTRAST_CODE_MIN`], or its mean lies far out in the frame's range of cell
 //!    means ([`SEED_LEVEL_MIN`]). All three are the classifier's own features (feature
-//!    3, the magnitudes of features 5 and 9, and of feature 0 of [`super::features`], computed here
-//!    the same way, bit for bit), so the rule can be checked on any feature dump
-//!    ([`is_seed_features`]). Every seed is classified.
+//!    3, the magnitudes of features 5 and 9, and of feature 0 of [`super::features`],
+//!    computed here the same way, bit for bit), so the rule can be checked on any
+//!    feature dump ([`is_seed_features`]). Every seed is classified.
 //! 2. **Growth**: every 8-neighbour of a target cell is classified too, until no new
 //!    target cell appears (a worklist, each cell classified at most once).
 //!
@@ -84,7 +84,8 @@ pub struct SeedRule {
     /// The frame's median cell mean, DN (feature 0's origin).
     p50: u64,
     /// `SEED_LEVEL_MIN · max(p98 − p2, σ)`: a cell is a level seed when `256 · |m − p50|`
-    /// reaches it (feature 0 rounds toward zero, so `|level| ≥ SEED_LEVEL_MIN` exactly then).
+    /// reaches it (feature 0 rounds toward zero, so `|level| ≥ SEED_LEVEL_MIN` exactly
+    /// then).
     level_x256: u64,
     /// `⌈SEED_CONTRAST_Q_MIN · σ / 4⌉`, DN: a cell is a contrast seed when its mean and a
     /// context box's (rounded down, as feature 5 + 4k takes it) differ by at least this

@@ -249,8 +249,7 @@ fn spot_of(
     // 9 × 120 × (core mean − ring mean); ≤ 120 · 9 · 4095 < 2^23 in magnitude.
     let num = RING_COUNT as i32 * s_inner - INNER_COUNT as i32 * ring_sum;
     let a = u64::from(num.unsigned_abs());
-    // A necessary condition without the variance: the spread is at least the floor.
-    if 16 * a < 9 * u64::from(admit16) * floor.n {
+    if under_floor(a, admit16, floor) {
         return None;
     }
     // 120² × the ring's variance (exact in these units; ≥ 0).
@@ -347,6 +346,14 @@ impl Centres<'_> {
             _ => reject_below,
         }
     }
+}
+
+/// `spot_of`'s first test, a necessary condition without the variance (the spread is at
+/// least the floor): true when `a` = |9 × 120 × (core mean − ring mean)| is too small
+/// for z ≥ `admit16` / 16 even at the floor's spread.
+#[inline(always)]
+fn under_floor(a: u64, admit16: u32, floor: Floor) -> bool {
+    16 * a < 9 * u64::from(admit16) * floor.n
 }
 
 /// The least |9 × 120 × (core mean − ring mean)| (`spot_of`'s `num`, under 2^23) that
@@ -949,7 +956,7 @@ mod tests {
                 random,
             ] {
                 let a = a.min((1 << 23) - 1);
-                let drops = 16 * u64::from(a) < 9 * u64::from(admit16) * floor.n;
+                let drops = under_floor(u64::from(a), admit16, floor);
                 assert_eq!(
                     a < bound,
                     drops,
