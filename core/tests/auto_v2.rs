@@ -29,8 +29,8 @@ use tirroi_core::frame::{FRAME_HEIGHT, FRAME_WIDTH};
 use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, DEEP_SPACE_SCORE_PERMILLE,
-    SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, rated_spots,
+    AutoV2, AutoV2Scratch, AutoV2Work, BORDER_PIECE_SCORE_PERMILLE, BlobRule,
+    DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, rated_spots,
 };
 use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
@@ -264,6 +264,9 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 if d.score_permille == SMALL_TARGET_SCORE_PERMILLE {
                     prop_assert!(det.small_target, "{d:?}");
                     SMALL_TARGET_SCORE_PERMILLE
+                } else if d.score_permille == BORDER_PIECE_SCORE_PERMILLE {
+                    // A component cut by one side of the window.
+                    BORDER_PIECE_SCORE_PERMILLE
                 } else {
                     DEEP_SPACE_SCORE_PERMILLE
                 }

@@ -119,8 +119,10 @@ pub struct AutoV2 {
     /// Stage 2c ([`smooth`]): a window whose cells fit a smooth surface within noise is
     /// deep space, and the cells departing from the surface are the target's (instead
     /// of the classifier's) where the refinement finds a boundary of `fine_sigma` σ in
-    /// them; such a box carries [`DEEP_SPACE_SCORE_PERMILLE`]. Otherwise, and when the
-    /// frame has a saturated blob (stage 2b decides then), the classifier decides.
+    /// them; such a box carries [`DEEP_SPACE_SCORE_PERMILLE`], or
+    /// [`BORDER_PIECE_SCORE_PERMILLE`] for cells cut by one side of the window that no
+    /// piece of the Earth's disc could be ([`EARTH_MIN_CHORD_CELLS`]). Otherwise, and when
+    /// the frame has a saturated blob (stage 2b decides then), the classifier decides.
     /// Default on.
     pub deep_space: bool,
     /// Stage 2d ([`small`]): where stage 2c takes the window for deep space but no
@@ -194,6 +196,83 @@ pub struct AutoV2 {
 /// inside its truth box), 2 on frames without a target. Session 29 measured 109 of 110
 /// (990 ‰) on the renders of its day. Above the default gate: no box changes with it.
 pub const DEEP_SPACE_SCORE_PERMILLE: u16 = 833;
+
+/// Confidence of a box of stage 2c whose component is cut by one side of the window
+/// ([`EARTH_MIN_CHORD_CELLS`]), ‰: its hit rate (IoU ≥ ½) on family A (session 51, seeds
+/// 7001–7201: famA, paper A, fixtures A, famAF, famAT, famAE, famASE): 6 of 8 boxes
+/// (Tango's panels and cubes cut by the frame over deep space, `famAT/000049`,
+/// `000119`, `000135`, `000287`, `000295`, `famA/000135`; the misses a part of a
+/// target, `famA/000035`, and an Earth-filled frame whose smooth night side passed the
+/// deep-space test, `famAF/000035`), none on a frame without a target.
+pub const BORDER_PIECE_SCORE_PERMILLE: u16 = 750;
+
+/// Stage 2c: the strongest cell of a component cut by one side must reach this code
+/// (1 + its departure in thresholds: 3 is two thresholds, 12 spreads of the sky's fit)
+/// to be boxed. The camera's shading departs from the fit at the frame's edges by a
+/// threshold or so (`famASE/000047`: the bright top edge of a target-less frame, boxed
+/// at 2); a target's faces depart by many. Chosen on family A: 3 is the smallest that
+/// boxes no frame without a target, and keeps the summed mean IoU (5 and 8 give back
+/// the gain, famAT 0.346 → 0.338 → 0.334).
+pub const BORDER_PIECE_MIN_CODE: u8 = 3;
+
+/// Stage 2c: a departing component cut by one side of the window is boxed (not left to
+/// the classifier) only when shorter along that side than this, cells (16: 128 px).
+/// From low orbit the Earth's limb has a radius of curvature in the image of
+/// f·tan ρ ≥ 2 300 px (ρ 64–70° from 800–400 km, f 1 140 px), so a piece of the disc
+/// cut by one side alone is at most c²/8R ≈ 6 px deep and, to show at all (1 px
+/// deep), at least 2√(2R) ≈ 136 px long. A component on two sides or longer may be
+/// the disc (session 31's geometry; a high orbit, where the disc fits in the frame,
+/// would need another bound).
+pub const EARTH_MIN_CHORD_CELLS: usize = 16;
+
+/// Whether a stage-2c component with cell box `w8` on plane `(pw, ph)` touches exactly
+/// one side of it and is shorter along that side than [`EARTH_MIN_CHORD_CELLS`]: no
+/// piece of the Earth's disc looks so ([`EARTH_MIN_CHORD_CELLS`]), a target cut by
+/// the frame does.
+fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
+    let on_vertical_side = w8.x0 == 0 || w8.x_end() >= pw;
+    let chord = if on_vertical_side {
+        w8.y_end().saturating_sub(usize::from(w8.y0))
+    } else {
+        w8.x_end().saturating_sub(usize::from(w8.x0))
+    };
+    w8.sides_touched((pw, ph)) == 1 && chord < EARTH_MIN_CHORD_CELLS
+}
+
+/// The strongest code of stage 2c's component `root` when every cell of it departing
+/// beyond the weak code lies above the fitted sky (its residual in `work.sum`, `f32`
+/// bits, as stage 2c left it), else `None`: nothing the camera sees is colder than deep space, so a target's cells only
+/// depart upwards, while the sky in a corner of a smooth Earth-filled frame departs
+/// downwards from the surface fitted to the Earth.
+fn departs_upwards<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> Option<u8> {
+    let mut strongest = 0u8;
+    for i in 0..n8 {
+        let (label, code) = (
+            work.labels8.as_ref().get(i).copied().unwrap_or(0),
+            work.labels4.as_ref().get(i).copied().unwrap_or(0),
+        );
+        if label != 0 && code > smooth::WEAK_CODE && work.comps.find(label) == root {
+            let residual = work.sum.as_ref().get(i).map_or(0.0, |&r| f32::from_bits(r));
+            if residual <= 0.0 {
+                return None;
+            }
+            strongest = strongest.max(code);
+        }
+    }
+    Some(strongest)
+}
+
+/// `r` carried out to each side of window `win` (plane `(pw, ph)` of its cells) that the
+/// cell box `w8` touches.
+fn to_touched_sides(r: Roi, w8: CellStats, (pw, ph): (usize, usize), win: Window) -> Roi {
+    let (x1, y1) = ((win.x0 + win.w) as u16, (win.y0 + win.h) as u16);
+    Roi {
+        x0: if w8.x0 == 0 { win.x0 as u16 } else { r.x0 },
+        y0: if w8.y0 == 0 { win.y0 as u16 } else { r.y0 },
+        x1: if w8.x_end() >= pw { x1 } else { r.x1 },
+        y1: if w8.y_end() >= ph { y1 } else { r.y1 },
+    }
+}
 
 /// Confidence of a box of stage 2d (a small target over deep space, [`small`]), ‰:
 /// its hit rate (IoU ≥ ½) on family A (seed 7001: realistic 6 of 16, paper 6 of 6,
@@ -1463,9 +1542,13 @@ impl AutoV2 {
 
     /// Stage 2c ([`smooth`]): when the window is deep space, its departing cells'
     /// strongest component refined as the classifier's winner is (stages 5, 7 and 8),
-    /// with [`DEEP_SPACE_SCORE_PERMILLE`]; `None` (the classifier decides) when the
-    /// window is not deep space, no cell departs or the refinement finds no boundary
-    /// (a far target within a cell's noise; the shading's own departures).
+    /// with [`DEEP_SPACE_SCORE_PERMILLE`] (a component cut by one side of the window
+    /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], departing upwards by at
+    /// least [`BORDER_PIECE_MIN_CODE`], whose box is no limb: with
+    /// [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier decides) when the
+    /// window is not deep space, no cell departs, the component touches the border
+    /// otherwise, or the refinement finds no boundary (a far target within a cell's
+    /// noise; the shading's own departures).
     ///
     /// Kept out of line (it runs once per frame): inlined into `run_in`, stage 2d's
     /// code (off by default) cost the M7 +0.22 M instructions on every embedded frame
@@ -1513,9 +1596,22 @@ impl AutoV2 {
         }
         // A component on the window's border may be the Earth's disc in a corner (the
         // rest of the frame deep space): the classifier, trained on such frames, decides.
-        if w8.sides_touched(plane8) > 0 {
+        // A component on the window's border may be the Earth's disc in a corner (the
+        // rest of the frame deep space): the classifier, trained on such frames,
+        // decides, unless the geometry rules the disc out (a target cut by one side,
+        // [`cut_by_one_side`]), which gets its own confidence.
+        let border = w8.sides_touched(plane8) > 0;
+        if border
+            && !(cut_by_one_side(w8, plane8)
+                && departs_upwards(work, n8, root).is_some_and(|c| c >= BORDER_PIECE_MIN_CODE))
+        {
             return None;
         }
+        let score_permille = if border {
+            BORDER_PIECE_SCORE_PERMILLE
+        } else {
+            DEEP_SPACE_SCORE_PERMILLE
+        };
         let d = self.finish(
             frame,
             work,
@@ -1523,9 +1619,19 @@ impl AutoV2 {
             plane8,
             lv,
             (root, w8, next),
-            DEEP_SPACE_SCORE_PERMILLE,
+            score_permille,
             true,
         );
+        // A piece of the Earth's limb after all (a smooth night side taken for deep
+        // space, its limb crossing the box): stage 4d's test, on the box carried to
+        // the window's side the component touches (the refinement may stop a pixel
+        // short of it).
+        if border
+            && d.roi
+                .is_some_and(|r| limb::is_limb(frame, to_touched_sides(r, w8, plane8, win)))
+        {
+            return None;
+        }
         // A box one pixel across is a hot pixel (the real camera's signature): no
         // target is imaged on fewer than 2 px across (the `realistic` world's
         // smallest far target: 3 px).
@@ -1543,7 +1649,7 @@ impl AutoV2 {
                 .flatten();
         }
         work.deep_space = Some(seen);
-        Some(if DEEP_SPACE_SCORE_PERMILLE < self.min_score_permille {
+        Some(if score_permille < self.min_score_permille {
             NO_TARGET
         } else {
             d
@@ -2447,6 +2553,63 @@ mod tests {
         let frame = Frame::reference(&px).unwrap();
         off.detect(&frame, &mut scratch).unwrap();
         assert!(scratch.work().deep_space().is_none());
+    }
+
+    /// The shaded sky of [`shaded_sky`] (with its hot pixel) and a face `dn` DN off the
+    /// sky over `x0..x1` × `y0..y1`.
+    fn shaded_sky_with(x0: usize, y0: usize, x1: usize, y1: usize, dn: i32) -> std::vec::Vec<u16> {
+        let mut px = shaded_sky(false, true);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let v = &mut px[y * FRAME_WIDTH + x];
+                *v = (i32::from(*v) + dn).clamp(0, 65_535) as u16;
+            }
+        }
+        px
+    }
+
+    /// Stage 2c at the window's border: a face brighter than the sky, cut by one side
+    /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], is boxed with
+    /// [`BORDER_PIECE_SCORE_PERMILLE`]; a band along a whole side (as long as a piece of
+    /// the Earth's disc), a piece in a corner (two sides) and a face colder than the
+    /// sky (the sky of a corner, the rest Earth) are not the stage's.
+    #[test]
+    fn a_target_cut_by_one_side_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let px = shaded_sky_with(0, 100, 30, 150, 200);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_some(), "{d:?}");
+        assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
+        let r = d.roi.expect("the cut target's box");
+        assert!(r.iou(&Roi::new(0, 100, 30, 150)) > 0.8, "{r:?}");
+        assert_eq!(
+            d,
+            det.detect(&frame, &mut scratch).unwrap(),
+            "same answer twice"
+        );
+        for (what, px) in [
+            (
+                "a band along the left side",
+                shaded_sky_with(0, 0, 20, FRAME_HEIGHT, 200),
+            ),
+            (
+                "a piece in the top-left corner",
+                shaded_sky_with(0, 0, 30, 40, 200),
+            ),
+            (
+                "a face colder than the sky",
+                shaded_sky_with(0, 100, 30, 150, -200),
+            ),
+        ] {
+            let frame = Frame::reference(&px).unwrap();
+            let d = det.detect(&frame, &mut scratch).unwrap();
+            assert!(
+                scratch.work().deep_space().is_none(),
+                "{what}: boxed by stage 2c, {d:?}"
+            );
+        }
     }
 
     /// Stage 2d: a 4×4-px target of 6 σ straddling four cells moves each cell's mean
