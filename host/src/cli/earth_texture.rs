@@ -8,6 +8,7 @@ use image::{GrayImage, Luma};
 
 use crate::imaging::image_io::read_frame;
 use crate::seed::splitmix64;
+use crate::world::earth::clouds::MAX_REGIONAL_RADIUS_CELLS;
 use crate::world::earth::texture_stats::{PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch};
 use crate::world::earth::{CloudField, OlrGrid};
 use crate::world::scene::MAX_CLOUD_TOP_TEXTURE_K;
@@ -39,6 +40,11 @@ pub struct EarthTextureArgs {
     /// 5), 0..=10.
     #[arg(long, default_value_t = 0.0)]
     pub cloud_top_texture_k: f64,
+    /// Radius of the regional cloud balance, cells (a scene file's
+    /// `earth_model.regional_balance_cells`; 0: each 1° cell balanced on its own),
+    /// 0..=4.
+    #[arg(long, default_value_t = 0)]
+    pub regional_balance_cells: usize,
 }
 
 /// Patch centres (latitude°, longitude° E) the statistics sample: the Hawaii sector of
@@ -116,8 +122,17 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
             args.cloud_top_texture_k
         ));
     }
-    let texture =
-        |day| builtin_field(args.seed, day).with_cloud_top_texture(args.cloud_top_texture_k);
+    if args.regional_balance_cells > MAX_REGIONAL_RADIUS_CELLS {
+        return Err(format!(
+            "--regional-balance-cells {}: expected 0..={MAX_REGIONAL_RADIUS_CELLS} cells",
+            args.regional_balance_cells
+        ));
+    }
+    let texture = |day| {
+        builtin_field(args.seed, day)
+            .with_cloud_top_texture(args.cloud_top_texture_k)
+            .with_regional_balance(args.regional_balance_cells)
+    };
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(

@@ -204,6 +204,14 @@ pub const FRAGMENT_MIN_COLD_K: f64 = 18.0;
 pub const FRAGMENT_MAX_COLD_K: f64 = 40.0;
 /// Rise of z above the threshold over which a fragment reaches its core depth, σ of z.
 pub const FRAGMENT_CORE_SIGMA: f64 = 0.6;
+/// Largest radius of [`CloudField::with_regional_balance`], cells (a 9 × 9 window:
+/// 900 km, the scale of the largest cloud systems a frame shows).
+pub const MAX_REGIONAL_RADIUS_CELLS: usize = 4;
+/// Step of the regional balance's derivative of a cell's flux with its shift, noise σ.
+const REGIONAL_STEP_SIGMA: f64 = 0.05;
+/// Largest correction of a window's mean shift by the regional balance, noise σ (a
+/// window of clear or overcast cells, whose flux no shift moves, keeps its mean shift).
+const MAX_REGIONAL_CORRECTION_SIGMA: f64 = 2.0;
 /// Sample points per axis of a cell's energy balance (16 × 16, cell-centred).
 pub const BALANCE_SAMPLES: usize = 16;
 /// Largest shift of a cell's cloud threshold its balance may use, noise σ (session 24:
@@ -377,6 +385,19 @@ pub struct CloudField {
     /// Texture of the tops outside deep convection, K per σ of the finer octaves
     /// ([`LOW_TOP_TEXTURE_K`] unless set).
     low_top_texture_k: f64,
+    /// Radius, cells, of the window of stand-alone threshold shifts each cell's final
+    /// shift is the mean of (0: each cell balanced on its own, the default; see
+    /// [`CloudField::with_regional_balance`]).
+    regional_radius_cells: usize,
+    /// Every cell's regional shift (the window's mean stand-alone shift), built on use.
+    regional_shifts: Vec<OnceLock<f64>>,
+    /// Every cell's mean stand-alone shift over its window, built on use.
+    mean_shifts: Vec<OnceLock<f64>>,
+    /// Every cell's flux at the mean shifts and its derivative, built on use.
+    mean_shift_fluxes: Vec<OnceLock<(f64, f64)>>,
+    /// Every cell's flux at the regional shifts (its target with a regional balance),
+    /// W m⁻², built on use.
+    regional_fluxes: Vec<OnceLock<f64>>,
     clear_t_k: Vec<f64>,
     cells: Vec<OnceLock<Box<Cell>>>,
     balance: Vec<OnceLock<Balance>>,
@@ -403,6 +424,11 @@ impl Clone for CloudField {
             small_sigma: self.small_sigma,
             coarse_over_meso_var: self.coarse_over_meso_var,
             low_top_texture_k: self.low_top_texture_k,
+            regional_radius_cells: self.regional_radius_cells,
+            regional_shifts: self.regional_shifts.clone(),
+            mean_shifts: self.mean_shifts.clone(),
+            mean_shift_fluxes: self.mean_shift_fluxes.clone(),
+            regional_fluxes: self.regional_fluxes.clone(),
             clear_t_k: self.clear_t_k.clone(),
             cells: self.cells.clone(),
             balance: self.balance.clone(),
@@ -422,6 +448,13 @@ fn blend_weights(t: f64, width: f64) -> [f64; 3] {
     let side = |d: f64| 0.5 * smoothstep(1.0 - d / width);
     let (a, c) = (side(t), side(1.0 - t));
     [a, 1.0 - a - c, c]
+}
+
+/// One empty lazy slot per 1° cell of the grid.
+fn per_cell<T>() -> Vec<OnceLock<T>> {
+    (0..OlrGrid::ROWS * OlrGrid::COLS)
+        .map(|_| OnceLock::new())
+        .collect()
 }
 
 fn smoothstep(x: f64) -> f64 {
@@ -499,19 +532,16 @@ impl CloudField {
             small_sigma: 1.0,
             coarse_over_meso_var: 1.0,
             low_top_texture_k: LOW_TOP_TEXTURE_K,
+            regional_radius_cells: 0,
+            regional_shifts: per_cell(),
+            mean_shifts: per_cell(),
+            mean_shift_fluxes: per_cell(),
+            regional_fluxes: per_cell(),
             clear_t_k,
-            cells: (0..OlrGrid::ROWS * OlrGrid::COLS)
-                .map(|_| OnceLock::new())
-                .collect(),
-            balance: (0..OlrGrid::ROWS * OlrGrid::COLS)
-                .map(|_| OnceLock::new())
-                .collect(),
-            tiles: (0..OlrGrid::ROWS * OlrGrid::COLS)
-                .map(|_| OnceLock::new())
-                .collect(),
-            final_scales: (0..OlrGrid::ROWS * OlrGrid::COLS)
-                .map(|_| OnceLock::new())
-                .collect(),
+            cells: per_cell(),
+            balance: per_cell(),
+            tiles: per_cell(),
+            final_scales: per_cell(),
             scales: OnceLock::new(),
         };
         // The noise's distribution on random directions (fixed stream: deterministic).
@@ -559,6 +589,23 @@ impl CloudField {
     /// cell's flux is kept as before (the texture is in the tile the balance measures).
     pub fn with_cloud_top_texture(mut self, k: f64) -> CloudField {
         self.low_top_texture_k = if k.is_finite() { k.max(0.0) } else { 0.0 };
+        self
+    }
+
+    /// The field with each cell's cloud threshold shift the mean of the stand-alone
+    /// shifts of the (2 · `radius_cells` + 1)² cells around it (rows beyond the poles
+    /// left out), and each cell's flux what that renders (0: every cell balanced on its
+    /// own, the default). With the shift of a cell alone, the cloud partition of a
+    /// smooth 1° flux field is the same share of every cell: the shift cancels the
+    /// noise's mean over the cell, so the octaves coarser than a cell cannot gather
+    /// clouds into masses and each cell holds its own blotches (session 51: a third of
+    /// the real image's cloud masses at 60–400 km). With a regional shift the clouds
+    /// follow the coarse octaves across cells (masses and bands), and the 1° fluxes
+    /// vary around the grid's as the masses do; their mean over a region stays the
+    /// grid's within a few W m⁻² (`tests/earth_texture.rs`). Call it on a new field,
+    /// before any temperature is read.
+    pub fn with_regional_balance(mut self, radius_cells: usize) -> CloudField {
+        self.regional_radius_cells = radius_cells.min(MAX_REGIONAL_RADIUS_CELLS);
         self
     }
 
@@ -789,7 +836,7 @@ impl CloudField {
                 m[4] += q * o2 * o2;
             }
         }
-        let target = f64::from(self.flux[row * OlrGrid::COLS + col]) * wsum;
+        let target = self.target(row, col) * wsum;
         let mut x = tile.s;
         for _ in 0..FINAL_SCALE_NEWTON_STEPS {
             let f = m[0] + x * (m[1] + x * (m[2] + x * (m[3] + x * m[4])));
@@ -860,7 +907,7 @@ impl CloudField {
             sum += w * STEFAN_BOLTZMANN_W_M2_K4 * line;
             wsum += w * (TILE_NODES - 1) as f64;
         }
-        let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
+        let target = self.target(row, col);
         if sum > 0.0 {
             tile.s = (target / (sum / wsum)).sqrt().sqrt();
         }
@@ -947,6 +994,19 @@ impl CloudField {
         pts
     }
 
+    /// The weighted mean σT⁴ of `pts` with the own shift `d` (point i's shift:
+    /// a_i·d + b_i), W m⁻².
+    fn mean_flux(&self, pts: &[(Point, f64, f64, f64)], ab: &[(f64, f64)], d: f64) -> f64 {
+        let wsum: f64 = pts.iter().map(|p| p.1).sum();
+        pts.iter()
+            .zip(ab)
+            .map(|((p, w, _, _), (a, b))| {
+                w * STEFAN_BOLTZMANN_W_M2_K4 * self.temperature(p, a * d + b).powi(4)
+            })
+            .sum::<f64>()
+            / wsum
+    }
+
     /// The shift in [−lim, lim] whose weighted mean σT⁴ of `pts` (shift of point i:
     /// a_i·δ + b_i) is `target` (bisection: the flux rises with the threshold).
     fn solve_shift(
@@ -955,16 +1015,7 @@ impl CloudField {
         ab: &[(f64, f64)],
         target: f64,
     ) -> (f64, f64) {
-        let wsum: f64 = pts.iter().map(|p| p.1).sum();
-        let flux_of = |d: f64| {
-            pts.iter()
-                .zip(ab)
-                .map(|((p, w, _, _), (a, b))| {
-                    w * STEFAN_BOLTZMANN_W_M2_K4 * self.temperature(p, a * d + b).powi(4)
-                })
-                .sum::<f64>()
-                / wsum
-        };
+        let flux_of = |d: f64| self.mean_flux(pts, ab, d);
         let lim = MAX_THRESHOLD_SHIFT_SIGMA * self.sigma;
         let (lo_f, hi_f) = (flux_of(-lim), flux_of(lim));
         // A flux the shift cannot reach: the least shift that gets within
@@ -1026,21 +1077,128 @@ impl CloudField {
     }
 
     /// The final balance: the own shift with the neighbours' (stand-alone) shifts
-    /// blended in as the renderer blends them, then s for the rest.
+    /// blended in as the renderer blends them, then s for the rest. With a regional
+    /// balance the shift is the regional one (the cell's flux is what it renders).
     fn build_balance(&self, row: usize, col: usize) -> Balance {
         let cell = self.cell(row, col);
         let pts = self.balance_points(cell, row, col);
+        let ab = if self.regional_radius_cells > 0 {
+            self.blend_coefficients(&pts, row, col, |r, c| self.regional_shift(r, c))
+        } else {
+            self.blend_coefficients(&pts, row, col, |r, c| self.cell(r, c).shift)
+        };
+        Balance {
+            shift: self.solve_shift(&pts, &ab, self.target(row, col)).0,
+        }
+    }
+
+    /// The mean stand-alone shift of the window of [`CloudField::with_regional_balance`]
+    /// around cell (`row`, `col`).
+    fn mean_shift(&self, row: usize, col: usize) -> f64 {
+        *self.mean_shifts[row * OlrGrid::COLS + col].get_or_init(|| {
+            let window = self.window(row, col, self.regional_radius_cells);
+            let sum: f64 = window.iter().map(|&(r, c)| self.cell(r, c).shift).sum();
+            sum / window.len().max(1) as f64
+        })
+    }
+
+    /// The mean σT⁴ of cell (`row`, `col`)'s balance points at the mean shifts
+    /// ([`CloudField::mean_shift`], blended across its borders as rendered), W m⁻², and
+    /// its derivative with every shift moved alike, W m⁻² per noise unit.
+    fn mean_shift_flux(&self, row: usize, col: usize) -> (f64, f64) {
+        *self.mean_shift_fluxes[row * OlrGrid::COLS + col].get_or_init(|| {
+            let cell = self.cell(row, col);
+            let pts = self.balance_points(cell, row, col);
+            let ab = self.blend_coefficients(&pts, row, col, |r, c| self.mean_shift(r, c));
+            let d = self.mean_shift(row, col);
+            let eps = REGIONAL_STEP_SIGMA * self.sigma;
+            let moved: Vec<(f64, f64)> =
+                ab.iter().map(|&(a, b)| (a, b + eps * (1.0 - a))).collect();
+            let f0 = self.mean_flux(&pts, &ab, d);
+            (f0, (self.mean_flux(&pts, &moved, d + eps) - f0) / eps)
+        })
+    }
+
+    /// The cell's regional shift: its own stand-alone shift without a regional balance;
+    /// with one the window's mean shift plus the one correction γ (a Newton step, the
+    /// same for the whole window) that brings the window's mean flux at the mean shifts
+    /// to the grid's: the mean of shifts does not keep a region's flux (it is not
+    /// linear in the shift; 1 % too little over 6 × 6 cells without it), and a
+    /// correction per cell's flux would step from cell to cell (the scale s then shows
+    /// the cells as blocks).
+    fn regional_shift(&self, row: usize, col: usize) -> f64 {
+        let radius = self.regional_radius_cells;
+        if radius == 0 {
+            return self.cell(row, col).shift;
+        }
+        *self.regional_shifts[row * OlrGrid::COLS + col].get_or_init(|| {
+            let (mut missing, mut slope) = (0.0, 0.0);
+            for (r, c) in self.window(row, col, radius) {
+                let (f, df) = self.mean_shift_flux(r, c);
+                missing += f64::from(self.flux[r * OlrGrid::COLS + c]) - f;
+                slope += df;
+            }
+            let limit = MAX_REGIONAL_CORRECTION_SIGMA * self.sigma;
+            let gamma = if slope > 0.0 {
+                (missing / slope).clamp(-limit, limit)
+            } else {
+                0.0
+            };
+            self.mean_shift(row, col) + gamma
+        })
+    }
+
+    /// The flux the texture keeps in cell (`row`, `col`), W m⁻²: the grid's, or with a
+    /// regional balance what the regional shifts render there.
+    fn target(&self, row: usize, col: usize) -> f64 {
+        if self.regional_radius_cells == 0 {
+            f64::from(self.flux[row * OlrGrid::COLS + col])
+        } else {
+            self.regional_flux(row, col)
+        }
+    }
+
+    /// The cells of the (2 · `radius` + 1)² window around cell (`row`, `col`), rows
+    /// beyond the poles left out, longitudes wrapped.
+    fn window(&self, row: usize, col: usize, radius: usize) -> Vec<(usize, usize)> {
+        (row.saturating_sub(radius)..(row + radius + 1).min(OlrGrid::ROWS))
+            .flat_map(|r| {
+                (0..=2 * radius)
+                    .map(move |dc| (r, (col + OlrGrid::COLS + dc - radius) % OlrGrid::COLS))
+            })
+            .collect()
+    }
+
+    /// The mean σT⁴ of cell (`row`, `col`)'s balance points at the regional shifts,
+    /// blended across its borders as rendered, W m⁻².
+    fn regional_flux(&self, row: usize, col: usize) -> f64 {
+        *self.regional_fluxes[row * OlrGrid::COLS + col].get_or_init(|| {
+            let cell = self.cell(row, col);
+            let pts = self.balance_points(cell, row, col);
+            let ab = self.blend_coefficients(&pts, row, col, |r, c| self.regional_shift(r, c));
+            self.mean_flux(&pts, &ab, self.regional_shift(row, col))
+        })
+    }
+
+    /// Per balance point of cell (`row`, `col`): (the own shift's blend weight, the
+    /// neighbours' shifts `shift_of` blended), as the renderer blends them.
+    fn blend_coefficients(
+        &self,
+        pts: &[(Point, f64, f64, f64)],
+        row: usize,
+        col: usize,
+        shift_of: impl Fn(usize, usize) -> f64,
+    ) -> Vec<(f64, f64)> {
         let mut nb = [[0.0f64; 3]; 3];
         for (dr, line) in nb.iter_mut().enumerate() {
             for (dc, v) in line.iter_mut().enumerate() {
                 if dr != 1 || dc != 1 {
                     let (r, c) = Self::neighbour(row, col, dr, dc);
-                    *v = self.cell(r, c).shift;
+                    *v = shift_of(r, c);
                 }
             }
         }
-        let ab: Vec<(f64, f64)> = pts
-            .iter()
+        pts.iter()
             .map(|&(_, _, u, v)| {
                 let (wy, wx) = (
                     blend_weights(u, SHIFT_BLEND_DEG),
@@ -1056,11 +1214,7 @@ impl CloudField {
                 }
                 (wy[1] * wx[1], b)
             })
-            .collect();
-        let target = f64::from(self.flux[row * OlrGrid::COLS + col]);
-        Balance {
-            shift: self.solve_shift(&pts, &ab, target).0,
-        }
+            .collect()
     }
 
     /// Temperature of a point with threshold shift `shift` (before the scale s), K.
@@ -1209,8 +1363,16 @@ impl CloudField {
     pub fn temperature_at_k(&self, lat_deg: f64, lon_deg: f64) -> f64 {
         self.temperature_k(lat_deg, lon_deg)
     }
-    /// The 1° flux of cell (`row`, `col`) the texture conserves, W m⁻².
+    /// The 1° flux of cell (`row`, `col`) the texture conserves, W m⁻²: the grid's,
+    /// or with [`CloudField::with_regional_balance`] what the regional shift renders
+    /// there (builds the cell's neighbourhood on first use).
     pub fn cell_flux_w_m2(&self, row: usize, col: usize) -> f32 {
+        self.target(row.min(OlrGrid::ROWS - 1), col % OlrGrid::COLS) as f32
+    }
+
+    /// The grid's 1° flux of cell (`row`, `col`), W m⁻² (what the texture was made
+    /// from; [`CloudField::cell_flux_w_m2`] is what it keeps).
+    pub fn grid_flux_w_m2(&self, row: usize, col: usize) -> f32 {
         self.flux[row.min(OlrGrid::ROWS - 1) * OlrGrid::COLS + col % OlrGrid::COLS]
     }
 }

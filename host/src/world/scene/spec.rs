@@ -11,7 +11,7 @@ use super::kinds::{
     Illumination, Mode, MoonSpec, OneOrMany, Param, SequenceSpec, TargetModel, ThermalModel,
 };
 use crate::world::constants::{EARTH_DISTANCE_M, EARTH_RADIUS_M};
-use crate::world::earth::clouds::LOW_TOP_TEXTURE_K;
+use crate::world::earth::clouds::{LOW_TOP_TEXTURE_K, MAX_REGIONAL_RADIUS_CELLS};
 use crate::world::earth::{ECLIPSE_FLUX_FACTOR, EarthMap};
 use crate::world::spacecraft::MaterialCase;
 
@@ -72,6 +72,18 @@ pub struct EarthModel {
     /// docs/scenes.md § Cloud-top texture). Not written by `--print-config` when 0.
     #[serde(skip_serializing_if = "is_zero")]
     pub cloud_top_texture_k: f64,
+    /// With `texture = "clouds"`: radius, cells, of the regional cloud balance
+    /// ([`crate::world::earth::CloudField::with_regional_balance`]: each 1° cell's
+    /// cloud threshold the mean of the (2r + 1)² cells' around it, so clouds gather
+    /// into masses across cells), 0..=4 (default 0: each cell balanced on its own; the
+    /// `realistic` presets set 1, docs/scenes.md § Cloud masses). Not written by
+    /// `--print-config` when 0.
+    #[serde(skip_serializing_if = "is_zero_cells")]
+    pub regional_balance_cells: usize,
+}
+
+fn is_zero_cells(v: &usize) -> bool {
+    *v == 0
 }
 
 impl Default for EarthModel {
@@ -87,6 +99,7 @@ impl Default for EarthModel {
             radius_km: EARTH_RADIUS_M / 1e3,
             texture: EarthTexture::Paper,
             cloud_top_texture_k: LOW_TOP_TEXTURE_K,
+            regional_balance_cells: 0,
         }
     }
 }
@@ -132,6 +145,18 @@ impl EarthModel {
             return Err(format!(
                 "earth_model.cloud_top_texture_k = {}: only the cloud texture has cloud tops (set texture = \"clouds\")",
                 self.cloud_top_texture_k
+            ));
+        }
+        if self.regional_balance_cells > MAX_REGIONAL_RADIUS_CELLS {
+            return Err(format!(
+                "earth_model.regional_balance_cells = {}: expected 0..={MAX_REGIONAL_RADIUS_CELLS} cells",
+                self.regional_balance_cells
+            ));
+        }
+        if self.regional_balance_cells > 0 && self.texture != EarthTexture::Clouds {
+            return Err(format!(
+                "earth_model.regional_balance_cells = {}: only the cloud texture has a cloud balance (set texture = \"clouds\")",
+                self.regional_balance_cells
             ));
         }
         Ok(())

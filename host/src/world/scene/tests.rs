@@ -123,6 +123,25 @@ fn errors_name_line_and_field() {
     )
     .unwrap();
     assert_eq!(f.earth_model.cloud_top_texture_k, 2.0);
+    // The regional cloud balance: only on the cloud texture, within 0..=4 cells.
+    let e = SceneFile::parse(&earth("regional_balance_cells = 1"), "x").unwrap_err();
+    assert!(e.to_string().contains("texture = \"clouds\""), "{e}");
+    let e = SceneFile::parse(
+        &earth("texture = \"clouds\"\nregional_balance_cells = 5"),
+        "x",
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("earth_model.regional_balance_cells = 5"),
+        "{e}"
+    );
+    let f = SceneFile::parse(
+        &earth("texture = \"clouds\"\nregional_balance_cells = 1"),
+        "x",
+    )
+    .unwrap();
+    assert_eq!(f.earth_model.regional_balance_cells, 1);
 }
 
 #[test]
