@@ -241,13 +241,24 @@ fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
     w8.sides_touched((pw, ph)) == 1 && chord < EARTH_MIN_CHORD_CELLS
 }
 
-/// The strongest code of stage 2c's component `root` when every cell of it departing
-/// beyond the weak code lies above the fitted sky (its residual in `work.sum`, `f32`
-/// bits, as stage 2c left it), else `None`: nothing the camera sees is colder than deep
-/// space, so a target's cells only depart upwards, while the sky in a corner of a
-/// smooth Earth-filled frame departs downwards from the surface fitted to the Earth.
-fn departs_upwards<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> Option<u8> {
-    let mut strongest = 0u8;
+/// Stage 2c's seed cells of a component: those departing beyond the weak code.
+#[derive(Debug, Clone, Copy)]
+struct Seeds {
+    /// The strongest seed's code (0: no seed, a component of weak departures alone).
+    strongest: u8,
+    /// Whether every seed lies above the fitted sky (its residual in `work.sum`, `f32`
+    /// bits, as stage 2c left it): nothing the camera sees is colder than deep space,
+    /// so a target's cells only depart upwards, while the sky in a corner of a smooth
+    /// Earth-filled frame departs downwards from the surface fitted to the Earth.
+    upwards: bool,
+}
+
+/// The [`Seeds`] of stage 2c's component `root` over the first `n8` cells, in one pass.
+fn seeds_of<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> Seeds {
+    let mut seeds = Seeds {
+        strongest: 0,
+        upwards: true,
+    };
     for i in 0..n8 {
         let (label, code) = (
             work.labels8.as_ref().get(i).copied().unwrap_or(0),
@@ -255,13 +266,11 @@ fn departs_upwards<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: 
         );
         if label != 0 && code > smooth::WEAK_CODE && work.comps.find(label) == root {
             let residual = work.sum.as_ref().get(i).map_or(0.0, |&r| f32::from_bits(r));
-            if residual <= 0.0 {
-                return None;
-            }
-            strongest = strongest.max(code);
+            seeds.upwards &= residual > 0.0;
+            seeds.strongest = seeds.strongest.max(code);
         }
     }
-    Some(strongest)
+    seeds
 }
 
 /// `r` carried out to each side of window `win` (plane `(pw, ph)` of its cells) that the
@@ -1586,11 +1595,8 @@ impl AutoV2 {
         };
         // A component of weakly departing cells alone is no target: a small target may
         // still be there at the pixel scale (stage 2d).
-        let has_seed = work.labels8.as_ref()[..n8]
-            .iter()
-            .zip(&work.labels4.as_ref()[..n8])
-            .any(|(&l, &c)| l != 0 && c > smooth::WEAK_CODE && work.comps.find(l) == root);
-        if !has_seed {
+        let seeds = seeds_of(work, n8, root);
+        if seeds.strongest == 0 {
             return self
                 .small_target
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
@@ -1603,7 +1609,8 @@ impl AutoV2 {
         let border = w8.sides_touched(plane8) > 0;
         if border
             && !(cut_by_one_side(w8, plane8)
-                && departs_upwards(work, n8, root).is_some_and(|c| c >= BORDER_PIECE_MIN_CODE))
+                && seeds.upwards
+                && seeds.strongest >= BORDER_PIECE_MIN_CODE)
         {
             return None;
         }
