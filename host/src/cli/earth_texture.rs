@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use image::{GrayImage, Luma};
 
-use crate::imaging::image_io::read_frame;
+use crate::imaging::image_io::{FrameBuf, read_frame, write_png16};
 use crate::seed::splitmix64;
 use crate::world::earth::clouds::MAX_REGIONAL_RADIUS_CELLS;
 use crate::world::earth::texture_stats::{PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch};
@@ -26,6 +26,11 @@ pub struct EarthTextureArgs {
     /// Write a side-by-side preview (ours | real, 220–300 K greyscale) to this PNG.
     #[arg(long)]
     pub preview: Option<PathBuf>,
+    /// Also write each patch the statistics sample as a 16-bit PNG in the real image's
+    /// encoding (value = BT × 50, 0.02 K per count) into this directory, for one's own
+    /// measurements beside the real scene; an existing file is never overwritten.
+    #[arg(long, requires = "stats")]
+    pub export: Option<PathBuf>,
     /// Dataset seed (the built-in OLR grid and the texture derive from it).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -45,6 +50,11 @@ pub struct EarthTextureArgs {
     /// 0..=4.
     #[arg(long, default_value_t = 0)]
     pub regional_balance_cells: usize,
+    /// Cold fragments bound to the clouds (a scene file's `earth_model.cloud_fragments`;
+    /// the `realistic` presets render them): more of them among clouds, fewer in clear
+    /// air, their tops below the cloud under them.
+    #[arg(long)]
+    pub cloud_fragments: bool,
 }
 
 /// Patch centres (latitude°, longitude° E) the statistics sample: the Hawaii sector of
@@ -67,7 +77,7 @@ pub fn builtin_field(seed: u64, day: u64) -> CloudField {
 
 fn row(name: &str, s: &TextureStats) -> String {
     format!(
-        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} | {:.2}, {:.0} |",
+        "| {name} | {:.1} / {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} / {:.2} | {:.2} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} | {:.0} % | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} | {:.2}, {:.0} |",
         s.step2_k[0],
         s.step2_k[1],
         s.step2_k[2],
@@ -83,6 +93,9 @@ fn row(name: &str, s: &TextureStats) -> String {
         s.bt_k[2],
         s.cold_features_per_10k_px[0],
         s.cold_features_per_10k_px[1],
+        100.0 * s.cold_feature_cloudy_share,
+        s.cold_feature_depth_k[0],
+        s.cold_feature_depth_k[1],
         s.cloud_top_sd_k[0],
         s.cloud_top_sd_k[1],
         100.0 * s.intermediate_share,
@@ -106,6 +119,35 @@ fn read_real(path: &Path) -> Result<(usize, usize, Vec<f64>), String> {
         })
         .collect();
     Ok((f.width, f.height, t))
+}
+
+/// Counts per kelvin of the real image's encoding (value = BT × 50).
+const REAL_COUNTS_PER_K: f64 = 50.0;
+
+/// Writes a patch in the real image's encoding; refuses to replace an existing file.
+fn export_patch(dir: &Path, name: &str, t_k: &[f64], size: usize) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let path = dir.join(name);
+    if path.exists() {
+        return Err(format!(
+            "{}: already exists; choose another --export directory or remove the file",
+            path.display()
+        ));
+    }
+    let frame = FrameBuf {
+        pixels: t_k
+            .iter()
+            .map(|&t| {
+                (t * REAL_COUNTS_PER_K)
+                    .round()
+                    .clamp(1.0, f64::from(u16::MAX)) as u16
+            })
+            .collect(),
+        width: size,
+        height: size,
+        bits: 16,
+    };
+    write_png16(&path, &frame).map_err(|e| e.to_string())
 }
 
 /// Runs the command.
@@ -132,13 +174,14 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
         builtin_field(args.seed, day)
             .with_cloud_top_texture(args.cloud_top_texture_k)
             .with_regional_balance(args.regional_balance_cells)
+            .with_cloud_fragments(args.cloud_fragments)
     };
     let real = args.real.as_deref().map(read_real).transpose()?;
     if args.stats {
         println!(
-            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % | cold structures ≥ 200 px per 10⁴ px, bands % |"
+            "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cold features among clouds | their depth p50 / p90, K | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % | cold structures ≥ 200 px per 10⁴ px, bands % |"
         );
-        println!("|---|---|---|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
         for day in 0..args.days {
             let field = texture(day);
             for &(lat, lon) in &PATCH_CENTRES {
@@ -151,6 +194,10 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
                     PATCH_PX_KM,
                     REAL_QUANTUM_K,
                 );
+                if let Some(dir) = &args.export {
+                    let name = format!("ours-seed{}-day{day}-{lat}N-{lon}E.png", args.seed);
+                    export_patch(dir, &name, &t, args.size)?;
+                }
                 if let Some(s) = TextureStats::of(&t, args.size, args.size, PATCH_PX_KM) {
                     println!("{}", row(&format!("ours day {day} ({lat}°, {lon}°)"), &s));
                 }

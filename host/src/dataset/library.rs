@@ -193,7 +193,8 @@ impl Library {
                     .map(|&day| {
                         let field = CloudField::new(&grids[&day], day as u64, file.dataset.seed)
                             .with_cloud_top_texture(file.earth_model.cloud_top_texture_k)
-                            .with_regional_balance(file.earth_model.regional_balance_cells);
+                            .with_regional_balance(file.earth_model.regional_balance_cells)
+                            .with_cloud_fragments(file.earth_model.cloud_fragments);
                         field.fill();
                         (day, Arc::new(field))
                     })

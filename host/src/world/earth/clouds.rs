@@ -204,6 +204,20 @@ pub const FRAGMENT_MIN_COLD_K: f64 = 18.0;
 pub const FRAGMENT_MAX_COLD_K: f64 = 40.0;
 /// Rise of z above the threshold over which a fragment reaches its core depth, σ of z.
 pub const FRAGMENT_CORE_SIGMA: f64 = 0.6;
+/// Threshold of the fragment field in clear air, σ of z, with
+/// [`CloudField::with_cloud_fragments`]: the real mild scene holds 0.2 compact cold
+/// features per 10⁴ px of clear background against 3–47 among clouds.
+pub const CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA: f64 = 4.5;
+/// Threshold of the fragment field at and inside a cloud, σ of z, with
+/// [`CloudField::with_cloud_fragments`].
+pub const CLOUD_FRAGMENT_THRESHOLD_SIGMA: f64 = 2.4;
+/// Distance outside a cloud's threshold over which the fragment threshold falls from
+/// its clear-air to its cloud value, noise σ.
+pub const CLOUD_FRAGMENT_REACH_SIGMA: f64 = 0.3;
+/// A cloud-bound fragment's top at its core lies this much below the cloud or clear sky
+/// under it, K (the real mild scene's compact cold features: 21 K below their
+/// surroundings at the median, 29 K at p90, 44.5 K at most).
+pub const CLOUD_FRAGMENT_MAX_COLD_K: f64 = 28.0;
 /// Largest radius of [`CloudField::with_regional_balance`], cells (a 9 × 9 window:
 /// 900 km, the scale of the largest cloud systems a frame shows).
 pub const MAX_REGIONAL_RADIUS_CELLS: usize = 4;
@@ -362,6 +376,9 @@ struct Point {
     fragment: f64,
     /// Temperature of the fragment's top, K (where `fragment` > 0).
     fragment_top_k: f64,
+    /// The fragment field in its σ ([`CloudField::with_cloud_fragments`] places the
+    /// fragments from it and the cloud below).
+    z_fragment: f64,
 }
 
 /// The cloud texture of one daily OLR grid (see the module docs). Cheap to clone only
@@ -389,6 +406,8 @@ pub struct CloudField {
     /// shift is the mean of (0: each cell balanced on its own, the default; see
     /// [`CloudField::with_regional_balance`]).
     regional_radius_cells: usize,
+    /// Cold fragments bound to the clouds ([`CloudField::with_cloud_fragments`]).
+    cloud_fragments: bool,
     /// Every cell's regional shift (the window's mean stand-alone shift plus the window's
     /// correction, [`CloudField::regional_shift`]), built on use.
     regional_shifts: Vec<OnceLock<f64>>,
@@ -426,6 +445,7 @@ impl Clone for CloudField {
             coarse_over_meso_var: self.coarse_over_meso_var,
             low_top_texture_k: self.low_top_texture_k,
             regional_radius_cells: self.regional_radius_cells,
+            cloud_fragments: self.cloud_fragments,
             regional_shifts: self.regional_shifts.clone(),
             mean_shifts: self.mean_shifts.clone(),
             mean_shift_fluxes: self.mean_shift_fluxes.clone(),
@@ -534,6 +554,7 @@ impl CloudField {
             coarse_over_meso_var: 1.0,
             low_top_texture_k: LOW_TOP_TEXTURE_K,
             regional_radius_cells: 0,
+            cloud_fragments: false,
             regional_shifts: per_cell(),
             mean_shifts: per_cell(),
             mean_shift_fluxes: per_cell(),
@@ -608,6 +629,24 @@ impl CloudField {
     /// taken as it. Call it on a new field, before any temperature is read.
     pub fn with_regional_balance(mut self, radius_cells: usize) -> CloudField {
         self.regional_radius_cells = radius_cells.min(MAX_REGIONAL_RADIUS_CELLS);
+        self
+    }
+
+    /// The field with its cold fragments bound to the clouds (`true`; `false`, the
+    /// default: the fragments of session 38, anywhere, their tops 18–40 K below the clear
+    /// sky, hidden by colder cloud). The real mild scene's compact cold features (at
+    /// most 60 px, more than 16 K below their 11 × 11 median) lie among clouds, on a
+    /// background at least 5 K below the clear sea, for 96 % of them (0.2 per 10⁴ px of
+    /// clear background against 3–47 among clouds), and reach 224 K; the session-38
+    /// fragments did so for 14 % (median of 8 patches) and never lay more than 40 K
+    /// below the clear sky (session 52, `tirroi earth-texture --stats`). Here the
+    /// fragment field's threshold is lower at and near a cloud than in clear air, and a
+    /// fragment's top lies below the cloud (or clear sky) under it: a tower out of a
+    /// deck, a cold core in a cirrus band. Call it on a new field, before any
+    /// temperature is read; each cell keeps its flux (the fragments are in the tile the
+    /// balance measures).
+    pub fn with_cloud_fragments(mut self, on: bool) -> CloudField {
+        self.cloud_fragments = on;
         self
     }
 
@@ -760,6 +799,7 @@ impl CloudField {
             low_texture,
             fragment,
             fragment_top_k,
+            z_fragment,
         }
     }
 
@@ -1082,13 +1122,17 @@ impl CloudField {
     /// blended in as the renderer blends them, then s for the rest. With a regional
     /// balance the shift is the regional one (the cell's flux is what it renders).
     fn build_balance(&self, row: usize, col: usize) -> Balance {
+        // With a regional balance the cell keeps what its regional shift renders (its
+        // target is that flux), so the shift is the regional one, exactly; solving for
+        // it again only returned it to the solver's tolerance.
+        if self.regional_radius_cells > 0 {
+            return Balance {
+                shift: self.regional_shift(row, col),
+            };
+        }
         let cell = self.cell(row, col);
         let pts = self.balance_points(cell, row, col);
-        let ab = if self.regional_radius_cells > 0 {
-            self.blend_coefficients(&pts, row, col, |r, c| self.regional_shift(r, c))
-        } else {
-            self.blend_coefficients(&pts, row, col, |r, c| self.cell(r, c).shift)
-        };
+        let ab = self.blend_coefficients(&pts, row, col, |r, c| self.cell(r, c).shift);
         Balance {
             shift: self.solve_shift(&pts, &ab, self.target(row, col)).0,
         }
@@ -1241,8 +1285,35 @@ impl CloudField {
             cold
         };
         let t = p.t_clear - cold.min(MAX_LOCAL_COLD_K);
+        if self.cloud_fragments {
+            return self.cloud_fragment(p, x, t);
+        }
         // A fragment's top hides what is below it where it is colder.
         t - p.fragment * (t - p.fragment_top_k).max(0.0)
+    }
+
+    /// The temperature `t` (K) of point `p`, `x` above its cloud threshold (noise
+    /// units), with a fragment of [`CloudField::with_cloud_fragments`]: the threshold of
+    /// the fragment field falls from [`CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA`] in clear
+    /// air to [`CLOUD_FRAGMENT_THRESHOLD_SIGMA`] at and inside a cloud (over
+    /// [`CLOUD_FRAGMENT_REACH_SIGMA`] noise σ outside its edge), and the fragment's top
+    /// lies [`FRAGMENT_MIN_COLD_K`] (edge) to [`CLOUD_FRAGMENT_MAX_COLD_K`] (core) below
+    /// `t` itself, never more than [`MAX_LOCAL_COLD_K`] below the clear sky.
+    fn cloud_fragment(&self, p: &Point, x: f64, t: f64) -> f64 {
+        let reach = CLOUD_FRAGMENT_REACH_SIGMA * self.sigma;
+        let near = smoothstep(x / reach + 1.0);
+        let threshold = CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA
+            + (CLOUD_FRAGMENT_THRESHOLD_SIGMA - CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA) * near;
+        let over = p.z_fragment - threshold;
+        if over <= -0.5 * FRAGMENT_EDGE_SIGMA {
+            return t;
+        }
+        let cold = FRAGMENT_MIN_COLD_K
+            + (CLOUD_FRAGMENT_MAX_COLD_K - FRAGMENT_MIN_COLD_K)
+                * smoothstep(over / FRAGMENT_CORE_SIGMA);
+        let cover = smoothstep(over / FRAGMENT_EDGE_SIGMA + 0.5);
+        let top = (t - cold).max(p.t_clear - MAX_LOCAL_COLD_K);
+        t - cover * (t - top).max(0.0)
     }
 
     /// The point at fractions (u lat, v lon) of `cell`.

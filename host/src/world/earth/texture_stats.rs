@@ -33,6 +33,10 @@ pub const LOCAL_MEDIAN_PX: usize = 11;
 pub const SMALL_FEATURE_MAX_PX: usize = 12;
 /// Largest mid-sized cold feature, px.
 pub const MID_FEATURE_MAX_PX: usize = 60;
+/// A cold feature whose local median lies this far below the warm reference sits among
+/// clouds, K: half the low clouds' shallowest depth ([`super::clouds::MIN_CLOUD_COLD_K`]
+/// is 15.5 K) and 10 real quantisation steps above the clear sea's own spread.
+pub const CLOUDY_BACKGROUND_K: f64 = 5.0;
 /// The image's warm reference, its clear sky: the brightness temperature at this
 /// quantile of its valid pixels (p90: cloud-free surface in any scene with less than
 /// 90 % cloud cover).
@@ -71,6 +75,13 @@ pub struct TextureStats {
     /// [`COLD_FEATURE_DEPTH_K`] below their local median, small (≤
     /// [`SMALL_FEATURE_MAX_PX`] px) and mid-sized (≤ [`MID_FEATURE_MAX_PX`] px).
     pub cold_features_per_10k_px: [f64; 2],
+    /// Share of those features (both sizes) whose local median at their deepest pixel
+    /// lies at least [`CLOUDY_BACKGROUND_K`] below the warm reference: cold elements
+    /// among clouds rather than over the clear surface (0..=1, NaN without a feature).
+    pub cold_feature_cloudy_share: f64,
+    /// Depth of those features' deepest pixel below its local median, p50 and p90, K
+    /// (NaN without a feature).
+    pub cold_feature_depth_k: [f64; 2],
     /// Texture of cloud tops: the standard deviation of the brightness temperature in
     /// the [`CLOUD_TOP_WINDOW_PX`]² windows whose pixels are all valid and at least
     /// [`CLOUD_TOP_DEPTH_K`] below the warm reference ([`WARM_QUANTILE`]), p50 and p90,
@@ -127,6 +138,7 @@ impl TextureStats {
         bt.sort_by(f64::total_cmp);
         // The clear surface: the reference of the cloud-top statistics.
         let warm_k = pct(&bt, WARM_QUANTILE);
+        let features = cold_features(t_k, w, h, warm_k);
         Some(TextureStats {
             step2_k: [
                 pct(&steps, 0.5),
@@ -137,7 +149,9 @@ impl TextureStats {
             step2_share_over: STEP2_SHARE_K.map(over),
             spectral_slope: spectral_slope(&rect, rw, rh, px_km),
             bt_k: [pct(&bt, 0.01), pct(&bt, 0.5), pct(&bt, 0.99)],
-            cold_features_per_10k_px: cold_features(t_k, w, h),
+            cold_features_per_10k_px: features.per_10k_px,
+            cold_feature_cloudy_share: features.cloudy_share,
+            cold_feature_depth_k: features.depth_k,
             cloud_top_sd_k: cloud_top_sd(t_k, w, h, warm_k),
             intermediate_share: bt
                 .iter()
@@ -184,13 +198,27 @@ pub fn cloud_top_sd(t_k: &[f64], w: usize, h: usize, warm_k: f64) -> [f64; 2] {
     [pct(&sds, 0.5), pct(&sds, 0.9)]
 }
 
-/// Small and mid-sized cold features per 10⁴ valid pixels of the row-major `w` × `h`
-/// image `t_k` (K, NaN = no data; see [`TextureStats::cold_features_per_10k_px`]): the
-/// local median over the valid pixels of each window, then 8-connected groups of the
-/// pixels below it by more than [`COLD_FEATURE_DEPTH_K`], sized by flood fill.
-pub fn cold_features(t_k: &[f64], w: usize, h: usize) -> [f64; 2] {
+/// The small and mid-sized cold features of an image ([`cold_features`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColdFeatures {
+    /// Per 10⁴ valid pixels, small and mid-sized ([`TextureStats::cold_features_per_10k_px`]).
+    pub per_10k_px: [f64; 2],
+    /// Share among clouds ([`TextureStats::cold_feature_cloudy_share`]).
+    pub cloudy_share: f64,
+    /// Depth below the local median, p50 and p90, K ([`TextureStats::cold_feature_depth_k`]).
+    pub depth_k: [f64; 2],
+}
+
+/// Small and mid-sized cold features of the row-major `w` × `h` image `t_k` (K, NaN =
+/// no data) with warm reference `warm_k` (see [`TextureStats::cold_features_per_10k_px`]):
+/// the local median over the valid pixels of each window, then 8-connected groups of
+/// the pixels below it by more than [`COLD_FEATURE_DEPTH_K`], sized by flood fill;
+/// each group's deepest pixel gives its depth and its background (the local median
+/// there).
+pub fn cold_features(t_k: &[f64], w: usize, h: usize, warm_k: f64) -> ColdFeatures {
     let r = LOCAL_MEDIAN_PX / 2;
     let mut cold = vec![false; w * h];
+    let mut median_k = vec![f64::NAN; w * h];
     let mut window: Vec<f64> = Vec::with_capacity(LOCAL_MEDIAN_PX * LOCAL_MEDIAN_PX);
     let mut valid = 0usize;
     for y in 0..h {
@@ -211,19 +239,41 @@ pub fn cold_features(t_k: &[f64], w: usize, h: usize) -> [f64; 2] {
             }
             let mid = window.len() / 2;
             let (_, median, _) = window.select_nth_unstable_by(mid, f64::total_cmp);
+            median_k[y * w + x] = *median;
             cold[y * w + x] = t < *median - COLD_FEATURE_DEPTH_K;
         }
     }
     let mut counts = [0usize; 2];
+    let mut cloudy = 0usize;
+    let mut depths = Vec::new();
     for_each_group(&mut cold, w, h, |group| {
-        if group.len() <= SMALL_FEATURE_MAX_PX {
-            counts[0] += 1;
-        } else if group.len() <= MID_FEATURE_MAX_PX {
-            counts[1] += 1;
+        if group.len() > MID_FEATURE_MAX_PX {
+            return;
         }
+        counts[usize::from(group.len() > SMALL_FEATURE_MAX_PX)] += 1;
+        let (depth, background) = group
+            .iter()
+            .map(|&i| (median_k[i] - t_k[i], median_k[i]))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap_or((f64::NAN, f64::NAN));
+        depths.push(depth);
+        cloudy += usize::from(warm_k - background >= CLOUDY_BACKGROUND_K);
     });
     let per = 1e4 / valid.max(1) as f64;
-    [counts[0] as f64 * per, counts[1] as f64 * per]
+    depths.sort_by(f64::total_cmp);
+    let (cloudy_share, depth_k) = if depths.is_empty() {
+        (f64::NAN, [f64::NAN; 2])
+    } else {
+        (
+            cloudy as f64 / depths.len() as f64,
+            [pct(&depths, 0.5), pct(&depths, 0.9)],
+        )
+    };
+    ColdFeatures {
+        per_10k_px: [counts[0] as f64 * per, counts[1] as f64 * per],
+        cloudy_share,
+        depth_k,
+    }
 }
 
 /// Each 8-connected group of the `true` pixels of the row-major `w` × `h` `mask`, as

@@ -115,7 +115,8 @@ impl RadiometryReadout {
     }
 }
 
-fn is_false(b: &bool) -> bool {
+/// Serde's skip test of a flag that is off by default (shared by the scene sections).
+pub(super) fn is_false(b: &bool) -> bool {
     !*b
 }
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use tirroi_core::sensor::DetectionScale;
 
-use super::camera::{Camera, RadiometryReadout};
+use super::camera::{Camera, RadiometryReadout, is_false};
 use super::kinds::{
     Illumination, Mode, MoonSpec, OneOrMany, Param, SequenceSpec, TargetModel, ThermalModel,
 };
@@ -80,6 +80,14 @@ pub struct EarthModel {
     /// `--print-config` when 0.
     #[serde(skip_serializing_if = "is_zero_cells")]
     pub regional_balance_cells: usize,
+    /// With `texture = "clouds"`: the small cold fragments bound to the clouds
+    /// ([`crate::world::earth::CloudField::with_cloud_fragments`]: more among clouds,
+    /// fewer in clear air, their tops 18–28 K below the cloud under them; default false:
+    /// anywhere, 18–40 K below the clear sky; the `realistic` presets set true,
+    /// docs/scenes.md § Cloud-bound fragments). Not written by `--print-config` when
+    /// false.
+    #[serde(skip_serializing_if = "is_false")]
+    pub cloud_fragments: bool,
 }
 
 fn is_zero_cells(v: &usize) -> bool {
@@ -100,6 +108,7 @@ impl Default for EarthModel {
             texture: EarthTexture::Paper,
             cloud_top_texture_k: LOW_TOP_TEXTURE_K,
             regional_balance_cells: 0,
+            cloud_fragments: false,
         }
     }
 }
@@ -158,6 +167,12 @@ impl EarthModel {
                 "earth_model.regional_balance_cells = {}: only the cloud texture has a cloud balance (set texture = \"clouds\")",
                 self.regional_balance_cells
             ));
+        }
+        if self.cloud_fragments && self.texture != EarthTexture::Clouds {
+            return Err(
+                "earth_model.cloud_fragments = true: only the cloud texture has cloud fragments (set texture = \"clouds\")"
+                    .into(),
+            );
         }
         Ok(())
     }

@@ -142,6 +142,15 @@ fn errors_name_line_and_field() {
     )
     .unwrap();
     assert_eq!(f.earth_model.regional_balance_cells, 1);
+    // Cloud-bound fragments: only on the cloud texture.
+    let e = SceneFile::parse(&earth("cloud_fragments = true"), "x").unwrap_err();
+    assert!(
+        e.to_string().contains("earth_model.cloud_fragments = true")
+            && e.to_string().contains("texture = \"clouds\""),
+        "{e}"
+    );
+    let f = SceneFile::parse(&earth("texture = \"clouds\"\ncloud_fragments = true"), "x").unwrap();
+    assert!(f.earth_model.cloud_fragments);
 }
 
 #[test]
