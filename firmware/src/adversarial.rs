@@ -11,7 +11,7 @@
 //! | `dots-S`, `holes-S`, S = 2, 3 | 4 | isolated pixels on a lattice: the most 8-connected components a frame holds (164 × 124 at S = 2) |
 //! | `framed-holes-S`, S = 2, 3 | 2 | `holes-S` inside an 8-px margin at a quarter of the range: a saturated blob over nearly the whole frame that passes `auto-v2`'s gate, so its refinement, body stage and shape statistics run over the whole frame (session 32: with the retrained forest `holes-3` no longer does) |
 //! | `plate-holes-S`, S = 2, 3 | 2 | `holes-S` on a plate at half the range, the margin on the top and left only: `auto`'s refinement scans every row and column of its region to the end without a boundary, in the whole frame and in the tracking window at the top-left corner (session 33: that small region counted 2.3× the refinement's per-pixel charge of the time) |
-//! | `weak-blob-S`, S = 2, 3 | 2 | `holes-S` on a saturated plate reaching the right and bottom edges, its top and left margin [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`] under the top: the blob model rates the blob over the gate but under `auto-v2`'s 800 ‰, so the region stages' whole-frame pass runs and then stage 5e's spots compete with it (session 47: the two together, which no other case reaches) |
+//! | `weak-blob-S`, S = 2, 3 | 2 | `holes-S` on a saturated plate reaching the right and bottom edges, its top and left margin ([`WEAK_BLOB_MARGIN_PX`]) [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`] under the top: `auto-v2` rates the blob over the gate but under its 800 ‰, so the region stages' whole-frame pass runs and then stage 5e's spots compete with it (session 47: the two together, which no other case reaches; the worst-case run fails when the rating leaves that range) |
 //! | `noise-N` | 4 | uniform noise over the whole 14-bit range: every histogram bin, random runs |
 //! | `salt-pepper-N` | 2 | each pixel 0 or saturated, at random |
 //! | `spikes-N` | 2 | 45 % black, 45 % saturated, the rest uniform between: a nearly flat score over the bins between, but not flat enough (Otsu refines 2 bins) |
@@ -59,8 +59,8 @@ pub enum Case {
     /// row's scan from the right or a column's from the bottom.
     PlateHoles(usize),
     /// [`Case::Holes`] on a saturated plate reaching the right and bottom edges, its
-    /// top and left margin ([`FRAME_MARGIN_PX`]) [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`] under
-    /// the top DN: a blob whose confidence passes the gate but not the spots' 800 ‰.
+    /// top and left margin ([`WEAK_BLOB_MARGIN_PX`]) [`WEAK_BLOB_MARGIN_BELOW_TOP_DN`]
+    /// under the top DN: a blob whose confidence passes the gate but not the spots' 800 ‰.
     WeakBlob(usize),
     /// Uniform noise over 0..=MAX_DN from seed `N`.
     Noise(u64),
@@ -93,10 +93,26 @@ const DOT_SPACINGS_PX: [usize; 2] = [2, 3];
 /// touch the frame's sides).
 pub const FRAME_MARGIN_PX: usize = 8;
 /// How far under the top DN the margin of [`Case::WeakBlob`] lies: surroundings this
-/// close to the top lower the blob model's ring depth, so the blob is rated 0.735
-/// (S = 3) and 0.67 (S = 2) on the host, between the gate (550 ‰) and the 800 ‰ under
-/// which the spots compete; 512 DN under the top rated it 0.812 (no competition).
+/// close to the top lower the blob model's ring depth, so the blob is rated between
+/// the gate (550 ‰) and the 800 ‰ under which the spots compete (session 47: 0.735 for
+/// S = 3, 0.67 for S = 2 on the host; 512 DN under the top rated it 0.812, no
+/// competition). The worst-case run checks the rating (`worst_case.rs`).
 pub const WEAK_BLOB_MARGIN_BELOW_TOP_DN: u16 = 256;
+/// Width of [`Case::WeakBlob`]'s top and left margin, px, for hole spacings S = 2
+/// and 3 ([`DOT_SPACINGS_PX`]). Session 52's cell forest rates `weak-blob-3` with
+/// [`FRAME_MARGIN_PX`]'s 8 px at 0.872 (over 800 ‰: the spots no longer compete,
+/// 19.16 M instead of the double path), with 7 px at 0.599; `weak-blob-2` stays in
+/// range with 8 px (0.557) and has no box with 7 px.
+pub const WEAK_BLOB_MARGIN_PX: [usize; 2] = [8, 7];
+
+/// [`WEAK_BLOB_MARGIN_PX`] of hole spacing `s` ([`FRAME_MARGIN_PX`] for another).
+fn weak_blob_margin_px(s: usize) -> usize {
+    DOT_SPACINGS_PX
+        .iter()
+        .position(|&d| d == s)
+        .and_then(|k| WEAK_BLOB_MARGIN_PX.get(k).copied())
+        .unwrap_or(FRAME_MARGIN_PX)
+}
 /// Seeds of the noise frames.
 const NOISE_SEEDS: [u64; 4] = [1, 2, 3, 4];
 /// Seeds of the salt-and-pepper frames.
@@ -292,13 +308,19 @@ pub fn fill(case: Case, frame: &mut [u16; FRAME_PIXELS]) {
             Case::Dots(s) => on(x % s == 0 && y % s == 0),
             Case::Holes(s) => on(!(x % s == 0 && y % s == 0)),
             Case::FramedHoles(s) | Case::PlateHoles(s) | Case::WeakBlob(s) => {
-                let (plate, margin, right_px, bottom_px) = match case {
-                    Case::PlateHoles(_) => (MAX_DN / 2, MAX_DN / 4, 0, 0),
-                    Case::WeakBlob(_) => (MAX_DN, MAX_DN - WEAK_BLOB_MARGIN_BELOW_TOP_DN, 0, 0),
+                let (plate, margin, left_px, right_px) = match case {
+                    Case::PlateHoles(_) => (MAX_DN / 2, MAX_DN / 4, FRAME_MARGIN_PX, 0),
+                    Case::WeakBlob(_) => (
+                        MAX_DN,
+                        MAX_DN - WEAK_BLOB_MARGIN_BELOW_TOP_DN,
+                        weak_blob_margin_px(s),
+                        0,
+                    ),
                     _ => (MAX_DN, MAX_DN / 4, FRAME_MARGIN_PX, FRAME_MARGIN_PX),
                 };
-                let inside = (FRAME_MARGIN_PX..FRAME_WIDTH - right_px).contains(&x)
-                    && (FRAME_MARGIN_PX..FRAME_HEIGHT - bottom_px).contains(&y);
+                // Top and left margins `left_px`, right and bottom `right_px`.
+                let inside = (left_px..FRAME_WIDTH - right_px).contains(&x)
+                    && (left_px..FRAME_HEIGHT - right_px).contains(&y);
                 match (inside, x % s == 0 && y % s == 0) {
                     (false, _) => margin,
                     (true, true) => 0,

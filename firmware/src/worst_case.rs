@@ -26,6 +26,7 @@ mod target {
     use cortex_m_semihosting::{debug, hprintln};
     use panic_semihosting as _;
     use tirroi_core::frame::{FRAME_HEIGHT, FRAME_PIXELS, FRAME_WIDTH};
+    use tirroi_core::roi::auto::learned::AutoV2;
     use tirroi_core::roi::auto::learned::look::Look;
     use tirroi_core::roi::auto::{BudgetReport, WorkBudget};
     use tirroi_core::{DetectError, Detection, Frame, Method, Roi};
@@ -118,6 +119,26 @@ mod target {
                 let (result, n) = count(overhead, || DETECTORS.run(method, &frame));
                 failed |= result.is_err();
                 calls += 1;
+                // The weak blob exists to make `auto-v2` run its whole-frame regions and
+                // then the spots: its rating must lie between the gate and the spots'
+                // threshold, or the case no longer reaches that path (a retrained model
+                // moves it; adversarial::WEAK_BLOB_MARGIN_PX).
+                if let (adversarial::Case::WeakBlob(_), Method::AutoV2, Ok(d)) =
+                    (case, method, &result)
+                {
+                    let v2 = AutoV2::DEFAULT;
+                    if !(v2.min_score_permille..v2.spot_competes_below_permille)
+                        .contains(&d.score_permille)
+                    {
+                        hprintln!(
+                            "worst error case={case} method={method} rated {} permille: outside {}..{}, the case misses its path",
+                            d.score_permille,
+                            v2.min_score_permille,
+                            v2.spot_competes_below_permille
+                        );
+                        failed = true;
+                    }
+                }
                 match DETECTORS.otsu_passes().filter(|_| method == Method::Otsu) {
                     Some(passes) => hprintln!(
                         "worst case={case} method={method} instructions={n} box={} passes={passes}",
