@@ -35,7 +35,10 @@
 //!   clear sky covers what is below it, with a 1–2 px edge: the small cold cloud elements
 //!   and dashes (towers, cirrus fragments) of real 4 km imagery, 1–12 px across, which
 //!   the cloud partition alone never made (its low clouds are 10–21 K deep, its deep
-//!   ones wide decks). They are in the tile, so the cell's balance below keeps the flux;
+//!   ones wide decks). They are in the tile, so the cell's balance below keeps the flux.
+//!   [`CloudField::with_cloud_fragments`] (session 52, the `realistic` presets) binds
+//!   them to the clouds: a lower threshold at and inside a cloud, a higher one in clear
+//!   air, and a top 18–28 K below the cloud (or clear sky) under it;
 //! - a threshold shift δ and a scale s, one pair per 1° cell: the cell's mean σT⁴,
 //!   measured on 16 × 16 points, equals its flux F. δ moves the cloud threshold θ + δ
 //!   (more or less cloud where the noise realisation has too little or too much); s
@@ -206,13 +209,20 @@ pub const FRAGMENT_MAX_COLD_K: f64 = 40.0;
 pub const FRAGMENT_CORE_SIGMA: f64 = 0.6;
 /// Threshold of the fragment field in clear air, σ of z, with
 /// [`CloudField::with_cloud_fragments`]: the real mild scene holds 0.2 compact cold
-/// features per 10⁴ px of clear background against 3–47 among clouds.
+/// features per 10⁴ px of clear background against 3–47 among clouds, so clear air
+/// keeps only the rare fragment (calibrated with the next two on `tirroi earth-texture
+/// --stats`, 24 patches: 3.9 / 2.45 / 0.5 left 18 % of them on clear background, these
+/// 17 %, the real scene 4 %; a higher clear threshold no longer moved it, as the rest
+/// lie at clouds' edges).
 pub const CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA: f64 = 4.5;
 /// Threshold of the fragment field at and inside a cloud, σ of z, with
-/// [`CloudField::with_cloud_fragments`].
+/// [`CloudField::with_cloud_fragments`]: sets their number (compact cold features 3.21
+/// per 10⁴ px over 24 patches, the real mild scene 3.02; 2.2 gave 5.96).
 pub const CLOUD_FRAGMENT_THRESHOLD_SIGMA: f64 = 2.4;
 /// Distance outside a cloud's threshold over which the fragment threshold falls from
-/// its clear-air to its cloud value, noise σ.
+/// its clear-air to its cloud value, noise σ: about one edge width of a deep cloud, so
+/// the fragments cluster at a cloud's fringe as well as inside it (0.5 put 1.22 per 10⁴
+/// px on clear background).
 pub const CLOUD_FRAGMENT_REACH_SIGMA: f64 = 0.3;
 /// A cloud-bound fragment's top at its core lies this much below the cloud or clear sky
 /// under it, K (the real mild scene's compact cold features: 21 K below their
