@@ -1,6 +1,7 @@
 //! `tirroi render` keeps a user's files: the run manifest, refusals (exit 2, one line,
 //! nothing touched), `--force`, `--resume` against the manifest, exact `--count`,
-//! Ctrl-C's resume command, and `--shard` + `tirroi merge` giving the single run's bytes.
+//! Ctrl-C's resume command, and `--shard` + `tirroi merge` giving the single run's bytes;
+//! `tirroi earth-texture --export` refusing to replace a patch.
 
 mod cli_common;
 
@@ -467,4 +468,44 @@ fn ctrl_c_prints_the_command_that_resumes() {
         ),
         "its seed is 5, not 6",
     );
+}
+
+/// `tirroi earth-texture --export DIR` writes each sampled patch in the real image's
+/// encoding (16-bit PNG, value = brightness temperature × 50) and never replaces a file:
+/// a second run into the same directory is refused with the file named, nothing touched.
+#[test]
+fn earth_texture_export_writes_the_real_encoding_and_keeps_existing_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("patches");
+    let dir_arg = dir.to_str().unwrap();
+    let args = [
+        "earth-texture",
+        "--stats",
+        "--days",
+        "1",
+        "--size",
+        "64",
+        "--cloud-fragments",
+        "--export",
+        dir_arg,
+    ];
+    ok(&tirroi_in(tmp.path(), &args));
+    let written = frames(&dir);
+    assert_eq!(written.len(), 4, "{written:?}");
+    assert!(
+        written.contains(&"ours-seed1-day0-20N-202E.png".to_string()),
+        "{written:?}"
+    );
+    for name in &written {
+        let img = image::open(dir.join(name)).unwrap().into_luma16();
+        assert_eq!(img.dimensions(), (64, 64), "{name}");
+        // Brightness temperatures of the Earth's longwave window, K.
+        for &v in img.as_raw() {
+            let t_k = f64::from(v) / 50.0;
+            assert!((150.0..=340.0).contains(&t_k), "{name}: {t_k} K");
+        }
+    }
+    let before = tree(&dir);
+    refused(&tirroi_in(tmp.path(), &args), "already exists");
+    assert_eq!(tree(&dir), before, "an existing patch was touched");
 }
