@@ -219,6 +219,8 @@ pub const CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA: f64 = 4.5;
 /// [`CloudField::with_cloud_fragments`]: sets their number (compact cold features 3.21
 /// per 10⁴ px over 24 patches, the real mild scene 3.02; 2.2 gave 5.96).
 pub const CLOUD_FRAGMENT_THRESHOLD_SIGMA: f64 = 2.4;
+// `CloudField::fragment` leaves early under the cloud threshold, the lower of the two.
+const _: () = assert!(CLOUD_FRAGMENT_THRESHOLD_SIGMA <= CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA);
 /// Distance outside a cloud's threshold over which the fragment threshold falls from
 /// its clear-air to its cloud value, noise σ: about one edge width of a deep cloud, so
 /// the fragments cluster at a cloud's fringe as well as inside it (0.5 put 1.22 per 10⁴
@@ -382,12 +384,10 @@ struct Point {
     /// Texture of the other clouds' tops, K ([`CloudField::with_cloud_top_texture`]; 0 by
     /// default), faded in from the cloud's edge as the core deepens.
     low_texture: f64,
-    /// Cover of a cold fragment, 0…1 (0 almost everywhere).
-    fragment: f64,
-    /// Temperature of the fragment's top, K (where `fragment` > 0).
-    fragment_top_k: f64,
-    /// The fragment field in its σ ([`CloudField::with_cloud_fragments`] places the
-    /// fragments from it and the cloud below).
+    /// The clear-sky temperature without its grain, K: the reference of session 38's
+    /// fragment tops.
+    fragment_clear_k: f64,
+    /// The fragment field in its σ (see [`CloudField::fragment`]).
     z_fragment: f64,
 }
 
@@ -786,18 +786,6 @@ impl CloudField {
         // The other tops: the field's own amplitude (0 by default, flat), faded in from
         // the cloud's edge where it is used (the edges keep their steps).
         let low_texture = (1.0 - deep) * self.low_top_texture_k * texture;
-        // Cold fragments: above the threshold, a sharp-edged top 18 K colder than the
-        // clear sky at the edge, 40 K at the core, whatever the cloud fraction (the
-        // real mild scene has them over clear sea and trade cumulus alike).
-        let over = z_fragment - FRAGMENT_THRESHOLD_SIGMA;
-        let (fragment, fragment_top_k) = if over > -0.5 * FRAGMENT_EDGE_SIGMA {
-            let cold = FRAGMENT_MIN_COLD_K
-                + (FRAGMENT_MAX_COLD_K - FRAGMENT_MIN_COLD_K)
-                    * smoothstep(over / FRAGMENT_CORE_SIGMA);
-            (smoothstep(over / FRAGMENT_EDGE_SIGMA + 0.5), t_clear - cold)
-        } else {
-            (0.0, t_clear)
-        };
         Point {
             t_clear: t_clear + grain,
             dt,
@@ -807,8 +795,7 @@ impl CloudField {
             deep,
             top_texture,
             low_texture,
-            fragment,
-            fragment_top_k,
+            fragment_clear_k: t_clear,
             z_fragment,
         }
     }
@@ -1295,34 +1282,51 @@ impl CloudField {
             cold
         };
         let t = p.t_clear - cold.min(MAX_LOCAL_COLD_K);
-        if self.cloud_fragments {
-            return self.cloud_fragment(p, x, t);
-        }
-        // A fragment's top hides what is below it where it is colder.
-        t - p.fragment * (t - p.fragment_top_k).max(0.0)
+        self.fragment(p, x, t)
     }
 
     /// The temperature `t` (K) of point `p`, `x` above its cloud threshold (noise
-    /// units), with a fragment of [`CloudField::with_cloud_fragments`]: the threshold of
-    /// the fragment field falls from [`CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA`] in clear
-    /// air to [`CLOUD_FRAGMENT_THRESHOLD_SIGMA`] at and inside a cloud (over
-    /// [`CLOUD_FRAGMENT_REACH_SIGMA`] noise σ outside its edge), and the fragment's top
-    /// lies [`FRAGMENT_MIN_COLD_K`] (edge) to [`CLOUD_FRAGMENT_MAX_COLD_K`] (core) below
-    /// `t` itself, never more than [`MAX_LOCAL_COLD_K`] below the clear sky.
-    fn cloud_fragment(&self, p: &Point, x: f64, t: f64) -> f64 {
-        let reach = CLOUD_FRAGMENT_REACH_SIGMA * self.sigma;
-        let near = smoothstep(x / reach + 1.0);
-        let threshold = CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA
-            + (CLOUD_FRAGMENT_THRESHOLD_SIGMA - CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA) * near;
+    /// units), with its cold fragment if the fragment field is over its threshold: a
+    /// sharp-edged top ([`FRAGMENT_EDGE_SIGMA`]) [`FRAGMENT_MIN_COLD_K`] colder at the
+    /// edge, deepening over [`FRAGMENT_CORE_SIGMA`], that hides what is below it where it
+    /// is colder. Session 38's fragments (the default): threshold
+    /// [`FRAGMENT_THRESHOLD_SIGMA`] anywhere, the top down to [`FRAGMENT_MAX_COLD_K`]
+    /// below the clear sky. [`CloudField::with_cloud_fragments`]: the threshold falls
+    /// from [`CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA`] in clear air to
+    /// [`CLOUD_FRAGMENT_THRESHOLD_SIGMA`] at and inside a cloud (over
+    /// [`CLOUD_FRAGMENT_REACH_SIGMA`] noise σ outside its edge), and the top lies down
+    /// to [`CLOUD_FRAGMENT_MAX_COLD_K`] below `t` itself, never more than
+    /// [`MAX_LOCAL_COLD_K`] below the clear sky.
+    fn fragment(&self, p: &Point, x: f64, t: f64) -> f64 {
+        // Almost every point lies under even the lowest threshold: out before the rest.
+        let lowest = if self.cloud_fragments {
+            CLOUD_FRAGMENT_THRESHOLD_SIGMA
+        } else {
+            FRAGMENT_THRESHOLD_SIGMA
+        };
+        if p.z_fragment - lowest <= -0.5 * FRAGMENT_EDGE_SIGMA {
+            return t;
+        }
+        let (threshold, max_cold_k) = if self.cloud_fragments {
+            let near = smoothstep(x / (CLOUD_FRAGMENT_REACH_SIGMA * self.sigma) + 1.0);
+            let threshold = CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA
+                + (CLOUD_FRAGMENT_THRESHOLD_SIGMA - CLOUD_FRAGMENT_CLEAR_THRESHOLD_SIGMA) * near;
+            (threshold, CLOUD_FRAGMENT_MAX_COLD_K)
+        } else {
+            (FRAGMENT_THRESHOLD_SIGMA, FRAGMENT_MAX_COLD_K)
+        };
         let over = p.z_fragment - threshold;
         if over <= -0.5 * FRAGMENT_EDGE_SIGMA {
             return t;
         }
         let cold = FRAGMENT_MIN_COLD_K
-            + (CLOUD_FRAGMENT_MAX_COLD_K - FRAGMENT_MIN_COLD_K)
-                * smoothstep(over / FRAGMENT_CORE_SIGMA);
+            + (max_cold_k - FRAGMENT_MIN_COLD_K) * smoothstep(over / FRAGMENT_CORE_SIGMA);
         let cover = smoothstep(over / FRAGMENT_EDGE_SIGMA + 0.5);
-        let top = (t - cold).max(p.t_clear - MAX_LOCAL_COLD_K);
+        let top = if self.cloud_fragments {
+            (t - cold).max(p.t_clear - MAX_LOCAL_COLD_K)
+        } else {
+            p.fragment_clear_k - cold
+        };
         t - cover * (t - top).max(0.0)
     }
 
