@@ -124,9 +124,9 @@ fn read_real(path: &Path) -> Result<(usize, usize, Vec<f64>), String> {
 /// Counts per kelvin of the real image's encoding (value = BT × 50).
 const REAL_COUNTS_PER_K: f64 = 50.0;
 
-/// Writes a patch in the real image's encoding; refuses to replace an existing file.
+/// Writes a patch into the existing directory `dir` in the real image's encoding;
+/// refuses to replace an existing file.
 fn export_patch(dir: &Path, name: &str, t_k: &[f64], size: usize) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let path = dir.join(name);
     if path.exists() {
         return Err(format!(
@@ -177,6 +177,10 @@ pub fn run(args: &EarthTextureArgs) -> Result<(), String> {
             .with_cloud_fragments(args.cloud_fragments)
     };
     let real = args.real.as_deref().map(read_real).transpose()?;
+    if let Some(dir) = &args.export {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    }
     if args.stats {
         println!(
             "| patch | 2-px step p50 / p90 / p99 / max, K | share > 1 / 2 K, % | share > 5 / 10 / 20 K, % | slope 8–200 km | BT p1 / p50 / p99, K | cold features small / mid per 10⁴ px | cold features among clouds | their depth p50 / p90, K | cloud-top 5×5 σ p50 / p90, K | 2–15 K below the warm p90, % | cold structures ≥ 200 px per 10⁴ px, bands % |"

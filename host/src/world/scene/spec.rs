@@ -150,29 +150,37 @@ impl EarthModel {
                 self.cloud_top_texture_k
             ));
         }
-        if self.cloud_top_texture_k > 0.0 && self.texture != EarthTexture::Clouds {
-            return Err(format!(
-                "earth_model.cloud_top_texture_k = {}: only the cloud texture has cloud tops (set texture = \"clouds\")",
-                self.cloud_top_texture_k
-            ));
-        }
         if self.regional_balance_cells > MAX_REGIONAL_RADIUS_CELLS {
             return Err(format!(
                 "earth_model.regional_balance_cells = {}: expected 0..={MAX_REGIONAL_RADIUS_CELLS} cells",
                 self.regional_balance_cells
             ));
         }
-        if self.regional_balance_cells > 0 && self.texture != EarthTexture::Clouds {
-            return Err(format!(
-                "earth_model.regional_balance_cells = {}: only the cloud texture has a cloud balance (set texture = \"clouds\")",
-                self.regional_balance_cells
-            ));
-        }
-        if self.cloud_fragments && self.texture != EarthTexture::Clouds {
-            return Err(
-                "earth_model.cloud_fragments = true: only the cloud texture has cloud fragments (set texture = \"clouds\")"
-                    .into(),
-            );
+        // The cloud texture's own settings, set away from their defaults: (set, the
+        // setting as written, what only the cloud texture has).
+        let cloud_settings = [
+            (
+                self.cloud_top_texture_k > 0.0,
+                format!("cloud_top_texture_k = {}", self.cloud_top_texture_k),
+                "cloud tops",
+            ),
+            (
+                self.regional_balance_cells > 0,
+                format!("regional_balance_cells = {}", self.regional_balance_cells),
+                "a cloud balance",
+            ),
+            (
+                self.cloud_fragments,
+                "cloud_fragments = true".to_string(),
+                "cloud fragments",
+            ),
+        ];
+        if self.texture != EarthTexture::Clouds {
+            if let Some((_, setting, what)) = cloud_settings.iter().find(|(set, ..)| *set) {
+                return Err(format!(
+                    "earth_model.{setting}: only the cloud texture has {what} (set texture = \"clouds\")"
+                ));
+            }
         }
         Ok(())
     }
