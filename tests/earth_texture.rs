@@ -3,15 +3,11 @@
 //! against the real image's README numbers, and the acceptance ranges.
 
 use tirroi_core::sensor::planck::STEFAN_BOLTZMANN_W_M2_K4;
+use tirroi_host::cli::earth_texture::{PATCH_CENTRES, builtin_field};
+use tirroi_host::world::earth::CloudField;
 use tirroi_host::world::earth::texture_stats::{
     PATCH_PX_KM, REAL_QUANTUM_K, TextureStats, sample_patch,
 };
-use tirroi_host::world::earth::{CloudField, OlrGrid};
-
-fn field(seed: u64, day: u64) -> CloudField {
-    let grid = OlrGrid::builtin(tirroi_host::seed::splitmix64(seed ^ 0xEA27) ^ day);
-    CloudField::new(&grid, day, seed)
-}
 
 /// The statistics of the `size`-px square patch of `f` centred at (`lat`, `lon`) at the
 /// real image's 4 km pixels and 0.5 K quantum.
@@ -45,7 +41,7 @@ fn cell_flux_error(f: &CloudField, row: usize, col: usize) -> f64 {
 #[test]
 
 fn every_cell_keeps_its_flux_within_half_a_percent() {
-    let f = field(1, 0);
+    let f = builtin_field(1, 0);
     let mut worst = 0.0f64;
     // A mild trade-wind block and a convective warm-pool block.
     for (r0, c0) in [(108usize, 200usize), (90, 138)] {
@@ -65,8 +61,8 @@ fn every_cell_keeps_its_flux_within_half_a_percent() {
 #[test]
 fn textured_cloud_tops_keep_the_flux() {
     use tirroi_host::world::earth::texture_stats::cloud_top_sd;
-    let flat = field(1, 0);
-    let f = field(1, 0).with_cloud_top_texture(5.0);
+    let flat = builtin_field(1, 0);
+    let f = builtin_field(1, 0).with_cloud_top_texture(5.0);
     let worst = [(108usize, 200usize), (109, 201), (90, 138), (91, 139)]
         .into_iter()
         .map(|(row, col)| cell_flux_error(&f, row, col))
@@ -90,7 +86,7 @@ fn textured_cloud_tops_keep_the_flux() {
 /// inside cells (no seams).
 #[test]
 fn no_seams_at_cell_borders() {
-    let f = field(1, 1);
+    let f = builtin_field(1, 1);
     let (mut border, mut interior) = (Vec::new(), Vec::new());
     let dx = 0.02; // ≈ 2 km
     for k in 0..40 {
@@ -127,7 +123,7 @@ fn no_seams_at_cell_borders() {
 /// 2.64 K and 11.93 K).
 #[test]
 fn no_seams_at_deep_convective_cell_borders() {
-    let f = field(1, 1);
+    let f = builtin_field(1, 1);
     let (h, n) = (0.03, 40);
     let step = |lat: f64, lon: f64, along_lat: bool| -> f64 {
         let mut s = 0.0;
@@ -180,8 +176,8 @@ fn no_seams_at_deep_convective_cell_borders() {
 
 #[test]
 fn same_inputs_same_bits_other_seed_or_day_other_clouds() {
-    let (a, b) = (field(7, 3), field(7, 3));
-    let (other_seed, other_day) = (field(8, 3), field(7, 4));
+    let (a, b) = (builtin_field(7, 3), builtin_field(7, 3));
+    let (other_seed, other_day) = (builtin_field(8, 3), builtin_field(7, 4));
     let mut diff_seed = 0;
     let mut diff_day = 0;
     // 400 points: 20 in each of 20 cells spread over the globe (−60…54° N, every
@@ -392,12 +388,11 @@ fn cloud_top_spread_is_measured_inside_the_cloud_only() {
 /// 1.1–2.7 % (8 of 8), p99 10.5–14 K).
 #[test]
 fn texture_statistics_within_the_acceptance_ranges() {
-    let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
     let (mut p99, mut share, mut slope) = (Vec::new(), Vec::new(), Vec::new());
     let mut small_cold = Vec::new();
     for day in 0..2 {
-        let f = field(1, day);
-        for &(lat, lon) in &places {
+        let f = builtin_field(1, day);
+        for &(lat, lon) in &PATCH_CENTRES {
             let s = patch_stats(&f, lat, lon, 256);
             eprintln!(
                 "day {day} ({lat}, {lon}): p99 {} K, share > 10 K {:.2} %, slope {:.2}",
@@ -466,7 +461,7 @@ fn texture_statistics_within_the_acceptance_ranges() {
 #[test]
 fn threshold_shifts_stay_off_their_bound() {
     use tirroi_host::world::earth::clouds::MAX_THRESHOLD_SHIFT_SIGMA;
-    let f = field(1, 0);
+    let f = builtin_field(1, 0);
     let mut worst = 0.0f64;
     for r in (35..145).step_by(11) {
         for c in (0..360).step_by(12) {
@@ -496,7 +491,7 @@ fn regional_balance_keeps_the_cells_and_the_regions_flux() {
     let mut region_errors = Vec::new();
     let mut largest_cell_move = 0.0f64;
     for day in 0..2 {
-        let f = field(1, day)
+        let f = builtin_field(1, day)
             .with_regional_balance(1)
             .with_cloud_fragments(true);
         for k in 0..20usize {
@@ -553,15 +548,14 @@ fn regional_balance_keeps_the_cells_and_the_regions_flux() {
 /// within ½–2× the real 2.6 per 10⁴ px (3.85).
 #[test]
 fn realistic_earth_has_cloud_masses_with_cold_fragments_among_them() {
-    let places = [(20.0, 202.0), (25.0, 320.0), (2.0, 140.0), (45.0, 330.0)];
     let (mut masses, mut slopes_in) = (Vec::new(), 0);
     let (mut cloudy, mut depth, mut small) = (Vec::new(), Vec::new(), Vec::new());
     for day in 0..2 {
-        let f = field(1, day)
+        let f = builtin_field(1, day)
             .with_cloud_top_texture(5.0)
             .with_regional_balance(1)
             .with_cloud_fragments(true);
-        for &(lat, lon) in &places {
+        for &(lat, lon) in &PATCH_CENTRES {
             let s = patch_stats(&f, lat, lon, 512);
             eprintln!(
                 "day {day} ({lat}, {lon}): cold structures {:.2} per 10⁴ px, bands {:.0} %, p99 {} K, slope {:.2}; cold features {:.1} per 10⁴ px, {:.0} % among clouds, depth p50 {:.1} K",
@@ -604,11 +598,10 @@ fn realistic_earth_has_cloud_masses_with_cold_fragments_among_them() {
         (1.3..=5.2).contains(&small_median),
         "small cold features {small:?}"
     );
-    masses.sort_by(f64::total_cmp);
-    let median = 0.5 * (masses[3] + masses[4]);
+    let masses_median = median(&mut masses);
     assert!(
-        (0.44..=1.76).contains(&median),
-        "median cold structures {median}"
+        (0.44..=1.76).contains(&masses_median),
+        "median cold structures {masses:?}"
     );
     assert!(
         slopes_in >= 7,
