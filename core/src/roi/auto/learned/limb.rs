@@ -11,6 +11,11 @@
 //! the box) follows a parabola within [`MAX_ARC_RMS2_PX2`]. A boundary pixel counts
 //! only with 3 px of its level behind it and of the other level beyond (session 50), so
 //! hot pixels and cold specks off the arc do not break the fit.
+//!
+//! The converse, [`bends`] (session 53): a boundary far from every parabola is a
+//! target's corner or bend, never the disc's arc; stage 2c boxes a piece in a corner of
+//! deep space only when its outline bends, since the disc cut by a corner shows there
+//! too.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -48,6 +53,16 @@ const MIN_BOUNDARY_PX: u32 = 8;
 /// meeting at a corner depart further).
 pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 
+/// Smallest mean squared distance, px², of the boundary pixels from the fitted
+/// parabola for an outline that bends ([`bends`]): 6 × [`MAX_ARC_RMS2_PX2`] (4.2 px
+/// rms). Between the largest non-target outline of family A (session 53, stage 2c's
+/// corner pieces of seeds 7001–7201: the paper world's limb in a corner, ragged by its
+/// noise, `paperA/000078`, 8.6 px², 3.0 ×) and the smallest target's corner piece that
+/// decides a frame (`famA/000039`, a rectangle's corner, 31.4 px², 10.9 ×), about
+/// twice the one and half the other; every factor from 3.1 to 10.8 gives family A the
+/// same answers.
+pub const MIN_BEND_RMS2_PX2: f64 = 6.0 * MAX_ARC_RMS2_PX2;
+
 /// Whether `roi` is a piece of the Earth's limb at the frame's border (see the module
 /// docs): `false` for a box not on the border, over a quarter of the frame, under
 /// 3 px on a side, at least a tenth saturated, with fewer than [`MIN_BOUNDARY_PX`]
@@ -56,6 +71,23 @@ pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 /// neighbours, 2·`BOUNDARY_DEPTH_PX` more where one is of the other level); 1 KiB
 /// of stack (the histogram).
 pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
+    arc_rms2_px2(frame, roi).is_some_and(|rms2| rms2 <= MAX_ARC_RMS2_PX2)
+}
+
+/// Whether the boundary in `roi` (at the frame's border, as [`is_limb`] reads it)
+/// departs from every parabola by at least [`MIN_BEND_RMS2_PX2`]: an outline with a
+/// corner or a bend inside the box, which a piece of the Earth's disc cut by the frame
+/// (one nearly straight arc) never shows. `false` wherever [`is_limb`] finds no
+/// boundary to fit (a box off the border, too large, saturated, too few boundary
+/// pixels): the answer must be measured. Same cost as [`is_limb`].
+pub fn bends(frame: &Frame<'_>, roi: Roi) -> bool {
+    arc_rms2_px2(frame, roi).is_some_and(|rms2| rms2 >= MIN_BEND_RMS2_PX2)
+}
+
+/// The mean squared distance, px², of the boundary pixels in `roi` from the best
+/// parabola (the lesser of `y` on `x` and `x` on `y`); `None` where [`is_limb`] says
+/// `false` before fitting (see there).
+fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
     let (w, h) = (frame.width(), frame.height());
     let (x0, y0, x1, y1) = (
         usize::from(roi.x0),
@@ -64,12 +96,12 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
         usize::from(roi.y1),
     );
     if x1 > w || y1 > h || x1 < x0 + 3 || y1 < y0 + 3 {
-        return false;
+        return None;
     }
     let on_border = [x0 == 0, y0 == 0, x1 == w, y1 == h];
     let area = (x1 - x0) * (y1 - y0);
     if !on_border.contains(&true) || area * MAX_FRAME_SHARE_DIVISOR > w * h {
-        return false;
+        return None;
     }
     let rows = || (y0..y1).filter_map(|y| frame.row(y).and_then(|r| r.get(x0..x1)));
     // Pass 1: the box's range and its saturated pixels.
@@ -83,7 +115,7 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
         }
     }
     if hi <= lo || saturated * SATURATED_SHARE_DIVISOR >= area as u32 {
-        return false;
+        return None;
     }
     // Pass 2: Otsu's threshold on a histogram of the box.
     let span = u32::from(hi - lo) + 1;
@@ -96,9 +128,7 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
             }
         }
     }
-    let Some(t_bin) = otsu_bin(&hist) else {
-        return false;
-    };
+    let t_bin = otsu_bin(&hist)?;
     // `bin(v) > t_bin` as one comparison: (v − lo)·256 / span ≥ t_bin + 1.
     let above_dn = u32::from(lo) + ((t_bin as u32 + 1) * span).div_ceil(OTSU_BINS as u32);
     let above = |v: u16| u32::from(v) >= above_dn;
@@ -159,10 +189,9 @@ pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
         }
     }
     if fit_x.n < f64::from(MIN_BOUNDARY_PX) {
-        return false;
+        return None;
     }
-    let rms2 = fit_x.residual2().min(fit_y.residual2());
-    rms2 <= MAX_ARC_RMS2_PX2
+    Some(fit_x.residual2().min(fit_y.residual2()))
 }
 
 /// The bin of Otsu's threshold (the last bin of the lower class) over `hist`; `None`
@@ -338,6 +367,37 @@ mod tests {
         let corner = frame_of(|x, y| x > 110.0 && y < 40.0);
         let g = Frame::new(&corner, W, H, 14).unwrap();
         assert!(is_limb(&g, roi(100, 0, 160, 40)));
+    }
+
+    #[test]
+    fn a_corner_bends_an_arc_does_not_a_ragged_arc_is_neither() {
+        // A rectangle cut by the top-left corner: an L inside its box.
+        let corner = frame_of(|x, y| x < 30.0 && y < 40.0);
+        let f = Frame::new(&corner, W, H, 14).unwrap();
+        let b = roi(0, 0, 50, 60);
+        assert!(bends(&f, b) && !is_limb(&f, b));
+        // The disc across the top-right corner: one arc.
+        let (cx, cy, r) = (160.0 + 480.0, -480.0, 700.0);
+        let disc = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
+        let f = Frame::new(&disc, W, H, 14).unwrap();
+        assert!(!bends(&f, roi(100, 0, 160, 50)));
+        // The same arc ragged by ±3 px every 8 px along it (a noisy limb, the paper
+        // world's, 8.6 px² on family A): not an arc within 1.7 px, no bend either.
+        let ragged = frame_of(|x, y| {
+            let step = if (x as usize / 8) % 2 == 0 { 3.0 } else { -3.0 };
+            (x - cx).hypot(y - cy) < r + step
+        });
+        let f = Frame::new(&ragged, W, H, 14).unwrap();
+        let b = roi(100, 0, 160, 50);
+        assert!(
+            !is_limb(&f, b) && !bends(&f, b),
+            "{:?}",
+            arc_rms2_px2(&f, b)
+        );
+        // No boundary to measure: no bend.
+        let flat = [1000u16; W * H];
+        let g = Frame::new(&flat, W, H, 14).unwrap();
+        assert!(!bends(&g, b));
     }
 
     #[test]

@@ -79,6 +79,7 @@ pub struct AutoV2 {
     /// otherwise the call goes on as with the prior alone.
     pub look: Option<look::Look>,
     /// Full-resolution boundary threshold, multiples of σ: 1..=1000. Default 8 (as `auto`).
+    /// Stage 2c's refinement uses the lesser of this and [`DEEP_SPACE_FINE_SIGMA`].
     pub fine_sigma: u16,
     /// A cell is a target cell when its score reaches this, score units
     /// ([`forest::SCORE_ONE`] per unit of log-odds): -4096..=4096. Default 0 (even
@@ -118,10 +119,12 @@ pub struct AutoV2 {
     pub blob: BlobRule,
     /// Stage 2c ([`smooth`]): a window whose cells fit a smooth surface within noise is
     /// deep space, and the cells departing from the surface are the target's (instead
-    /// of the classifier's) where the refinement finds a boundary of `fine_sigma` σ in
-    /// them; such a box carries [`DEEP_SPACE_SCORE_PERMILLE`], or
-    /// [`BORDER_PIECE_SCORE_PERMILLE`] for cells cut by one side of the window that no
-    /// piece of the Earth's disc could be ([`EARTH_MIN_CHORD_CELLS`]). Otherwise, and when
+    /// of the classifier's) where the refinement finds a boundary of
+    /// [`DEEP_SPACE_FINE_SIGMA`] σ (at most `fine_sigma`) in them; such a box carries
+    /// [`DEEP_SPACE_SCORE_PERMILLE`], or [`BORDER_PIECE_SCORE_PERMILLE`] for cells cut
+    /// by one side of the window that no piece of the Earth's disc could be
+    /// ([`EARTH_MIN_CHORD_CELLS`]) or by a corner with an outline that bends
+    /// ([`limb::bends`]: the disc's is one arc). Otherwise, and when
     /// the frame has a saturated blob (stage 2b decides then), the classifier decides.
     /// Default on.
     pub deep_space: bool,
@@ -206,6 +209,11 @@ pub const DEEP_SPACE_SCORE_PERMILLE: u16 = 833;
 /// the misses a part of a target, `famA/000035`, and an Earth-filled frame whose smooth
 /// night side passed the deep-space test, `famAF/000035`), none on a frame without a
 /// target. On the renders with cloud masses: 12 of 13 (`famAF/000035` no longer).
+/// Also the confidence of stage 2c's corner pieces ([`in_corner`], session 53): on
+/// session 52's renders the stage's border boxes of family A (both kinds) hit 16 of 20
+/// (the corner pieces 3 of 4: `famA/000039`, `000119`, `famAT/000237`; the miss a
+/// panel of `famAT/000050`, IoU 0.16), 800 ‰, within the sampling error of 857 (kept:
+/// no box moves with it).
 pub const BORDER_PIECE_SCORE_PERMILLE: u16 = 857;
 
 /// Stage 2c: the strongest cell of a component cut by one side must reach this code
@@ -224,7 +232,7 @@ pub const BORDER_PIECE_MIN_CODE: u8 = 3;
 /// cut by one side alone is at most c²/8R ≈ 6 px deep and, to show at all (1 px
 /// deep), at least 2√(2R) ≈ 136 px long. A component on two sides or longer may be
 /// the disc (session 31's geometry; a high orbit, where the disc fits in the frame,
-/// would need another bound).
+/// would need another bound); in a corner, the outline tells ([`in_corner`]).
 pub const EARTH_MIN_CHORD_CELLS: usize = 16;
 
 /// Whether a stage-2c component with cell box `w8` on plane `(pw, ph)` touches exactly
@@ -244,21 +252,32 @@ fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
 /// Stage 2c's seed cells of a component: those departing beyond the weak code.
 #[derive(Debug, Clone, Copy)]
 struct Seeds {
+    /// The strongest code of the seeds above the fitted sky (their residual in
+    /// `work.sum`, `f32` bits, as stage 2c left it; 0: none).
+    up: u8,
+    /// The strongest code of the seeds at or below the fitted sky (0: none). Nothing
+    /// the camera sees is colder than deep space, so a target's cells depart upwards,
+    /// while the sky in a corner of a smooth Earth-filled frame departs downwards from
+    /// the surface fitted to the Earth; next to a bright target the fit may overshoot,
+    /// so weaker cells beside it depart downwards (`famA/000105`: up 5, down 2).
+    down: u8,
+}
+
+impl Seeds {
     /// The strongest seed's code (0: no seed, a component of weak departures alone).
-    strongest: u8,
-    /// Whether every seed lies above the fitted sky (its residual in `work.sum`, `f32`
-    /// bits, as stage 2c left it): nothing the camera sees is colder than deep space,
-    /// so a target's cells only depart upwards, while the sky in a corner of a smooth
-    /// Earth-filled frame departs downwards from the surface fitted to the Earth.
-    upwards: bool,
+    fn strongest(self) -> u8 {
+        self.up.max(self.down)
+    }
+
+    /// Whether every seed departs upwards.
+    fn upwards(self) -> bool {
+        self.down == 0
+    }
 }
 
 /// The [`Seeds`] of stage 2c's component `root` over the first `n8` cells, in one pass.
 fn seeds_of<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> Seeds {
-    let mut seeds = Seeds {
-        strongest: 0,
-        upwards: true,
-    };
+    let mut seeds = Seeds { up: 0, down: 0 };
     for i in 0..n8 {
         let (label, code) = (
             work.labels8.as_ref().get(i).copied().unwrap_or(0),
@@ -266,11 +285,31 @@ fn seeds_of<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> 
         );
         if label != 0 && code > smooth::WEAK_CODE && work.comps.find(label) == root {
             let residual = work.sum.as_ref().get(i).map_or(0.0, |&r| f32::from_bits(r));
-            seeds.upwards &= residual > 0.0;
-            seeds.strongest = seeds.strongest.max(code);
+            let side = if residual > 0.0 {
+                &mut seeds.up
+            } else {
+                &mut seeds.down
+            };
+            *side = (*side).max(code);
         }
     }
     seeds
+}
+
+/// Whether a stage-2c component with cell box `w8` on plane `(pw, ph)` lies in a
+/// corner of it: it touches two adjacent sides (not a band across the window) and is
+/// shorter than [`EARTH_MIN_CHORD_CELLS`] along both. The Earth's disc cut by a
+/// corner looks so too; its in-frame outline is one nearly straight arc, a target's
+/// bends ([`limb::bends`], tested on the refined box).
+fn in_corner(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
+    let (left, top, right, bottom) = (w8.x0 == 0, w8.y0 == 0, w8.x_end() >= pw, w8.y_end() >= ph);
+    let across = w8.x_end().saturating_sub(usize::from(w8.x0));
+    let down = w8.y_end().saturating_sub(usize::from(w8.y0));
+    w8.sides_touched((pw, ph)) == 2
+        && (left || right)
+        && (top || bottom)
+        && across < EARTH_MIN_CHORD_CELLS
+        && down < EARTH_MIN_CHORD_CELLS
 }
 
 /// `r` carried out to each side of window `win` (plane `(pw, ph)` of its cells) that the
@@ -296,6 +335,17 @@ pub const SMALL_TARGET_SCORE_PERMILLE: u16 = 545;
 /// Stage 2c's box side moves out to its cells' where they reach this many cells beyond
 /// the refined box: a face too faint for a boundary of `fine_sigma` σ.
 pub const DEEP_SPACE_FACE_CELLS: usize = 1;
+
+/// Stage 2c's full-resolution boundary threshold, σ (at most [`AutoV2::fine_sigma`]).
+/// Over deep space the background is a fitted smooth surface under white noise: a
+/// step across two pixels (noise √2 σ) of 6 σ is 4.2 of their σ, about 3 in 10⁵ pixels
+/// by chance, while targets cut by a corner over the shaded sky show steps of 7–8 σ
+/// (`famA/000039`: 14 DN at σ 2 DN, `000119`: 6.5 σ) that 8 σ misses. Chosen on
+/// family A (session 53, seeds 7001–7201, ½ convention, with the corner rule; summed
+/// mean IoU of famA, paper A, fixtures A, famAF and famAT, Tango close): 8 → 2.4938 /
+/// 0.3664, 7 → 2.4968 / 0.3701, **6 → 2.4965 / 0.3739**, 5 → 2.4939 / 0.3716; no
+/// false alarm added on famAE, famASE or any other set.
+pub const DEEP_SPACE_FINE_SIGMA: u16 = 6;
 
 /// Stage 2c's box must be at least this many pixels on each side, else the classifier
 /// decides: a departure of one pixel across is a hot pixel.
@@ -1552,14 +1602,16 @@ impl AutoV2 {
     }
 
     /// Stage 2c ([`smooth`]): when the window is deep space, its departing cells'
-    /// strongest component refined as the classifier's winner is (stages 5, 7 and 8),
-    /// with [`DEEP_SPACE_SCORE_PERMILLE`] (a component cut by one side of the window
-    /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], departing upwards by at
-    /// least [`BORDER_PIECE_MIN_CODE`], whose box is no limb: with
-    /// [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier decides) when the
-    /// window is not deep space, no cell departs, the component touches the border
-    /// otherwise, or the refinement finds no boundary (a far target within a cell's
-    /// noise; the shading's own departures).
+    /// strongest component refined as the classifier's winner is (stages 5, 7 and 8,
+    /// boundaries of [`DEEP_SPACE_FINE_SIGMA`] σ), with [`DEEP_SPACE_SCORE_PERMILLE`]
+    /// (a component cut by one side of the window and shorter along it than
+    /// [`EARTH_MIN_CHORD_CELLS`], departing upwards by at least
+    /// [`BORDER_PIECE_MIN_CODE`], whose box is no limb, or one in a corner
+    /// ([`in_corner`]) whose strongest seed departs upwards and whose outline bends
+    /// ([`limb::bends`]): with [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier
+    /// decides) when the window is not deep space, no cell departs, the component
+    /// touches the border otherwise, or the refinement finds no boundary (a far target
+    /// within a cell's noise; the shading's own departures).
     ///
     /// Kept out of line (it runs once per frame): inlined into `run_in`, stage 2d's
     /// code (off by default) cost the M7 +0.22 M instructions on every embedded frame
@@ -1596,7 +1648,7 @@ impl AutoV2 {
         // A component of weakly departing cells alone is no target: a small target may
         // still be there at the pixel scale (stage 2d).
         let seeds = seeds_of(work, n8, root);
-        if seeds.strongest == 0 {
+        if seeds.strongest() == 0 {
             return self
                 .small_target
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
@@ -1607,10 +1659,14 @@ impl AutoV2 {
         // decides, unless the geometry rules the disc out (a target cut by one side,
         // [`cut_by_one_side`]), which gets its own confidence.
         let border = w8.sides_touched(plane8) > 0;
+        // A component in a corner whose strongest seed departs upwards is the stage's
+        // when its outline bends (tested after the refinement, below).
+        let corner = in_corner(w8, plane8) && seeds.up > seeds.down;
         if border
+            && !corner
             && !(cut_by_one_side(w8, plane8)
-                && seeds.upwards
-                && seeds.strongest >= BORDER_PIECE_MIN_CODE)
+                && seeds.upwards()
+                && seeds.strongest() >= BORDER_PIECE_MIN_CODE)
         {
             return None;
         }
@@ -1636,6 +1692,15 @@ impl AutoV2 {
         if border
             && d.roi
                 .is_some_and(|r| limb::is_limb(frame, to_touched_sides(r, w8, plane8, win)))
+        {
+            return None;
+        }
+        // A corner piece must show a target's bend (a disc's corner piece is one arc;
+        // a box whose boundary cannot be measured is left to the classifier).
+        if corner
+            && !d
+                .roi
+                .is_some_and(|r| limb::bends(frame, to_touched_sides(r, w8, plane8, win)))
         {
             return None;
         }
@@ -1878,7 +1943,12 @@ impl AutoV2 {
         let saturated = counts.sat_px >= MIN_SATURATED_PX
             && 8u32.saturating_mul(counts.near_px) < counts.sat_px;
         let _ = SATURATED_TAU_FACTOR;
-        let tau = (u32::from(self.fine_sigma) * lv.sigma).min(u32::from(u16::MAX)) as u16;
+        let fine_sigma = if space {
+            self.fine_sigma.min(DEEP_SPACE_FINE_SIGMA)
+        } else {
+            self.fine_sigma
+        };
+        let tau = (u32::from(fine_sigma) * lv.sigma).min(u32::from(u16::MAX)) as u16;
         let noise = super::noise::Noise {
             sigma: lv.sigma,
             clean: false,
@@ -2577,9 +2647,10 @@ mod tests {
 
     /// Stage 2c at the window's border: a face brighter than the sky, cut by one side
     /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], is boxed with
-    /// [`BORDER_PIECE_SCORE_PERMILLE`]; a band along a whole side (as long as a piece of
-    /// the Earth's disc), a piece in a corner (two sides) and a face colder than the
-    /// sky (the sky of a corner, the rest Earth) are not the stage's.
+    /// [`BORDER_PIECE_SCORE_PERMILLE`], and so is a rectangle in a corner (its outline
+    /// bends); a band along a whole side (as long as a piece of the Earth's disc), the
+    /// Earth's disc across a corner (one straight arc) and a face colder than the sky
+    /// (the sky of a corner, the rest Earth) are not the stage's.
     #[test]
     fn a_target_cut_by_one_side_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
         let det = AutoV2::default();
@@ -2596,15 +2667,33 @@ mod tests {
             det.detect(&frame, &mut scratch).unwrap(),
             "same answer twice"
         );
+        // A rectangle cut by the top-left corner: its outline inside the frame is an L.
+        let px = shaded_sky_with(0, 0, 30, 40, 200);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_some(), "{d:?}");
+        assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
+        let r = d.roi.expect("the corner piece's box");
+        assert!(r.iou(&Roi::new(0, 0, 30, 40)) > 0.8, "{r:?}");
+        // The Earth's disc (radius 700 px) cutting the same corner, as bright: its
+        // boundary is one straight arc.
+        let mut limb = shaded_sky(false, true);
+        let (cx, cy, radius) = (-470.0f32, -470.0f32, 700.0f32);
+        for (i, v) in limb.iter_mut().enumerate() {
+            let (x, y) = (
+                (i % FRAME_WIDTH) as f32 + 0.5,
+                (i / FRAME_WIDTH) as f32 + 0.5,
+            );
+            if libm::hypotf(x - cx, y - cy) < radius {
+                *v += 200;
+            }
+        }
         for (what, px) in [
             (
                 "a band along the left side",
                 shaded_sky_with(0, 0, 20, FRAME_HEIGHT, 200),
             ),
-            (
-                "a piece in the top-left corner",
-                shaded_sky_with(0, 0, 30, 40, 200),
-            ),
+            ("the Earth's disc across the top-left corner", limb),
             (
                 "a face colder than the sky",
                 shaded_sky_with(0, 100, 30, 150, -200),
