@@ -1607,11 +1607,12 @@ impl AutoV2 {
     /// (a component cut by one side of the window and shorter along it than
     /// [`EARTH_MIN_CHORD_CELLS`], departing upwards by at least
     /// [`BORDER_PIECE_MIN_CODE`], whose box is no limb, or one in a corner
-    /// ([`in_corner`]) whose strongest seed departs upwards and whose outline bends
+    /// ([`in_corner`]) whose outline bends
     /// ([`limb::bends`]): with [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier
-    /// decides) when the window is not deep space, no cell departs, the component
-    /// touches the border otherwise, or the refinement finds no boundary (a far target
-    /// within a cell's noise; the shading's own departures).
+    /// decides) when the window is not deep space, no cell departs, the component's
+    /// strongest seed departs downwards (colder than deep space: the Earth read as
+    /// smooth), the component touches the border otherwise, or the refinement finds no
+    /// boundary (a far target within a cell's noise; the shading's own departures).
     ///
     /// Kept out of line (it runs once per frame): inlined into `run_in`, stage 2d's
     /// code (off by default) cost the M7 +0.22 M instructions on every embedded frame
@@ -1658,10 +1659,23 @@ impl AutoV2 {
         // rest of the frame deep space): the classifier, trained on such frames,
         // decides, unless the geometry rules the disc out (a target cut by one side,
         // [`cut_by_one_side`]), which gets its own confidence.
+        // Nothing the camera sees is colder than deep space, so a target's cells depart
+        // upwards from the fitted sky. A strongest component whose strongest seed
+        // departs downwards means the smooth surface was fitted to the Earth (an
+        // Earth-filled frame with sparse cold clouds passes the deep-space test) and
+        // its cold cloud would be boxed: the classifier decides (session 53; session 51
+        // applied the same physics to pieces cut by one side, [`Seeds::upwards`]). On
+        // family A (seeds 7001–7201, ½ convention): summed mean IoU 2.4965 → 2.5083
+        // (famAF 0.2295 → 0.2411: faint far targets over the Earth reach the
+        // classifier), famAT 0.3739 → 0.3769, false alarms famAE 19 → 10 of 300,
+        // famASE 27 → 15 of 480, famAT 4 → 1, famAF 4 → 3; no set lower.
+        if seeds.up <= seeds.down {
+            return None;
+        }
         let border = w8.sides_touched(plane8) > 0;
-        // A component in a corner whose strongest seed departs upwards is the stage's
-        // when its outline bends (tested after the refinement, below).
-        let corner = in_corner(w8, plane8) && seeds.up > seeds.down;
+        // A component in a corner is the stage's when its outline bends (tested after
+        // the refinement, below).
+        let corner = in_corner(w8, plane8);
         if border
             && !corner
             && !(cut_by_one_side(w8, plane8)
@@ -2706,6 +2720,25 @@ mod tests {
                 "{what}: boxed by stage 2c, {d:?}"
             );
         }
+    }
+
+    /// Stage 2c: a face colder than the fitted sky inside the window is no target over
+    /// deep space (nothing is colder than it): the window is the Earth read as smooth
+    /// with a cold cloud, and the stage leaves it to the classifier; the same face
+    /// warmer than the sky is the stage's.
+    #[test]
+    fn a_face_colder_than_the_sky_is_left_to_the_classifier() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let px = shaded_sky_with(120, 90, 180, 140, -200);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_none(), "{d:?}");
+        let px = shaded_sky_with(120, 90, 180, 140, 200);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_some(), "{d:?}");
+        assert_eq!(d.score_permille, DEEP_SPACE_SCORE_PERMILLE, "{d:?}");
     }
 
     /// Stage 2d: a 4×4-px target of 6 σ straddling four cells moves each cell's mean
