@@ -347,6 +347,16 @@ pub const DEEP_SPACE_FACE_CELLS: usize = 1;
 /// false alarm added on famAE, famASE or any other set.
 pub const DEEP_SPACE_FINE_SIGMA: u16 = 6;
 
+/// A box of stages 2b–8 under this many pixels on a side is no target (stage 5e's spots
+/// may still answer): nothing is imaged on fewer than 2 px across (the optics' blur; the
+/// `realistic` world's smallest far target is 3 px), while the real camera's hot pixel
+/// is one. Session 53, family A (seeds 7001–7201, ½ convention): the 1-px boxes were hot
+/// pixels the confidence rated 0.87–0.90 in frames without a target (`famAE/000032`,
+/// `000119`, `famA/000084`, `famAT/000138`) or one pixel of a far target the spots then
+/// box whole (`famAF/000318`, `000330`); summed mean IoU 2.5083 → 2.5176, false alarms
+/// famA 1 → 0, famAE 10 → 8, famAT 1 → 0, famAT's IoU 0.3769 → 0.3768.
+pub const MIN_BOX_SIDE_PX: u16 = 2;
+
 /// Stage 2c's box must be at least this many pixels on each side, else the classifier
 /// decides: a departure of one pixel across is a hot pixel.
 pub const DEEP_SPACE_MIN_SIDE_PX: u16 = 2;
@@ -659,7 +669,8 @@ impl<C: FrameCapacity> AutoV2Work<C> {
     }
 
     /// What the region stage chose on the last frame (`None` when stage 4d found its
-    /// box to be the Earth's limb at the frame's border).
+    /// box to be the Earth's limb at the frame's border, or the box was under
+    /// [`MIN_BOX_SIDE_PX`]).
     pub fn winner(&self) -> Option<Winner> {
         self.winner
     }
@@ -1372,6 +1383,18 @@ impl AutoV2 {
         work.spot = None;
         work.candidate = None;
         let d = self.region_stages(frame, work, win, plane8, lv);
+        let d = if d
+            .roi
+            .is_some_and(|r| r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX)
+        {
+            // No stage's answer: as stage 4d drops a limb.
+            work.winner = None;
+            work.blob_won = false;
+            work.deep_space = None;
+            NO_TARGET
+        } else {
+            d
+        };
         if d.roi.is_some() {
             // A weak answer of a whole-frame search: stage 5e competes, the likelier hit
             // wins (in a tracking window the prior says where the target is).
@@ -2720,6 +2743,28 @@ mod tests {
                 "{what}: boxed by stage 2c, {d:?}"
             );
         }
+    }
+
+    /// A hot pixel alone in a clipped deep sky (0 DN but for it, as the real camera's
+    /// saturated hot pixels and the paper world's sky show) is no target: the region
+    /// stages' 1-px box is dropped ([`MIN_BOX_SIDE_PX`]), whatever the confidence.
+    #[test]
+    fn a_lone_hot_pixel_is_no_target() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let mut px = std::vec![0u16; FRAME_WIDTH * FRAME_HEIGHT];
+        let top = (1u16 << crate::frame::DEFAULT_BIT_DEPTH) - 1;
+        for &(x, y) in &[(72usize, 31usize), (200, 150), (40, 220)] {
+            px[y * FRAME_WIDTH + x] = top;
+        }
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert_eq!(d.roi, None, "{d:?}");
+        assert_eq!(
+            d,
+            det.detect(&frame, &mut scratch).unwrap(),
+            "same answer twice"
+        );
     }
 
     /// Stage 2c: a face colder than the fitted sky inside the window is no target over
