@@ -232,7 +232,11 @@ pub const BORDER_PIECE_MIN_CODE: u8 = 3;
 /// cut by one side alone is at most c²/8R ≈ 6 px deep and, to show at all (1 px
 /// deep), at least 2√(2R) ≈ 136 px long. A component on two sides or longer may be
 /// the disc (session 31's geometry; a high orbit, where the disc fits in the frame,
-/// would need another bound); in a corner, the outline tells ([`in_corner`]).
+/// would need another bound); in a corner, the outline tells ([`in_corner`]). The
+/// paper's camera at 10 871 km sees a smaller disc, R ≈ 700 px
+/// ([`EARTH_MIN_LIMB_RADIUS_PX`]): a piece 1 px deep is then ≥ 75 px long, so pieces
+/// of the disc shorter than this bound exist, 1–3 px deep: stage 4d's arc test on the
+/// box catches them unless the box is deeper than the disc ([`deeper_than_the_disc`]).
 pub const EARTH_MIN_CHORD_CELLS: usize = 16;
 
 /// Whether a stage-2c component with cell box `w8` on plane `(pw, ph)` touches exactly
@@ -247,6 +251,34 @@ fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
         w8.x_end().saturating_sub(usize::from(w8.x0))
     };
     w8.sides_touched((pw, ph)) == 1 && chord < EARTH_MIN_CHORD_CELLS
+}
+
+/// The smallest radius of curvature of the Earth's limb in the image, px: the camera
+/// at 10 871 km from the Earth's centre (the paper's scene) sees the disc's edge as an
+/// arc of ~700–830 px (`limb`'s module docs); nearer the Earth it is larger.
+pub const EARTH_MIN_LIMB_RADIUS_PX: u32 = 700;
+
+/// Slack on the disc's greatest depth, px: the refined box's side may stand a pixel or
+/// two beyond the limb (the optics' blur, the boundary's staircase).
+pub const LIMB_DEPTH_SLACK_PX: u32 = 2;
+
+/// Whether the box `r` of a stage-2c component cut by one side (cell box `w8` on plane
+/// `(pw, ph)`) reaches deeper into the frame than a piece of the Earth's disc cut by that
+/// side could: a chord `c` of a circle of radius R sags by c²/8R, so a piece as long
+/// along the side as `r` is at most c²/(8 · [`EARTH_MIN_LIMB_RADIUS_PX`]) +
+/// [`LIMB_DEPTH_SLACK_PX`] deep. A target's face cut by the side with a straight edge
+/// across it passes stage 4d's arc test, but not this. Session 53, family A (seeds
+/// 7001–7201, ½ convention): pieces taken for the limb before boxed now (`famA/000049`
+/// 0 → 0.84, `famAT/000251`, `000253`, `fixA/000042`), summed mean IoU 2.5176 →
+/// 2.5224, famAT 0.3768 → 0.3830, no false alarm added on any set.
+fn deeper_than_the_disc(r: Roi, w8: CellStats, (pw, _): (usize, usize)) -> bool {
+    let on_vertical_side = w8.x0 == 0 || w8.x_end() >= pw;
+    let (chord, depth) = if on_vertical_side {
+        (u32::from(r.height()), u32::from(r.width()))
+    } else {
+        (u32::from(r.width()), u32::from(r.height()))
+    };
+    depth > chord * chord / (8 * EARTH_MIN_LIMB_RADIUS_PX) + LIMB_DEPTH_SLACK_PX
 }
 
 /// Stage 2c's seed cells of a component: those departing beyond the weak code.
@@ -1725,10 +1757,13 @@ impl AutoV2 {
         // A piece of the Earth's limb after all (a smooth night side taken for deep
         // space, its limb crossing the box): stage 4d's test, on the box carried to
         // the window's side the component touches (the refinement may stop a pixel
-        // short of it).
+        // short of it), unless a piece cut by one side is deeper than the disc's.
         if border
-            && d.roi
-                .is_some_and(|r| limb::is_limb(frame, to_touched_sides(r, w8, plane8, win)))
+            && d.roi.is_some_and(|r| {
+                let carried = to_touched_sides(r, w8, plane8, win);
+                (corner || !deeper_than_the_disc(carried, w8, plane8))
+                    && limb::is_limb(frame, carried)
+            })
         {
             return None;
         }
@@ -2743,6 +2778,30 @@ mod tests {
                 "{what}: boxed by stage 2c, {d:?}"
             );
         }
+    }
+
+    /// Stage 2c: a target cut by the left side, a bright face by the side and a dim one
+    /// beyond it. Stage 4d's arc test reads its box as two levels split by one straight
+    /// line (the face boundary: a limb to the outline alone), but the piece reaches 40
+    /// px into the frame over a 60-px chord, deeper than a piece of the Earth's disc
+    /// could (≤ 2.6 px): boxed.
+    #[test]
+    fn a_deep_piece_cut_by_one_side_is_no_limb() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let mut px = shaded_sky(false, true);
+        for y in 90..150usize {
+            for x in 0..40usize {
+                px[y * FRAME_WIDTH + x] += if x < 20 { 200 } else { 80 };
+            }
+        }
+        let frame = Frame::reference(&px).unwrap();
+        let truth = Roi::new(0, 90, 40, 150);
+        assert!(limb::is_limb(&frame, truth), "the outline alone says limb");
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_some(), "{d:?}");
+        assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
+        assert!(d.roi.expect("the piece's box").iou(&truth) > 0.7, "{d:?}");
     }
 
     /// A hot pixel alone in a clipped deep sky (0 DN but for it, as the real camera's
