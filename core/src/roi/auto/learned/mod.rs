@@ -2723,30 +2723,33 @@ mod tests {
     /// bends); a band along a whole side (as long as a piece of the Earth's disc), the
     /// Earth's disc across a corner (one straight arc) and a face colder than the sky
     /// (the sky of a corner, the rest Earth) are not the stage's.
-    #[test]
-    fn a_target_cut_by_one_side_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
+    /// Asserts that stage 2c boxes `px` as a border piece ([`BORDER_PIECE_SCORE_PERMILLE`])
+    /// with IoU above `min_iou` against `truth`, the same twice.
+    fn assert_border_piece(px: &[u16], truth: Roi, min_iou: f32) {
         let det = AutoV2::default();
         let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
-        let px = shaded_sky_with(0, 100, 30, 150, 200);
-        let frame = Frame::reference(&px).unwrap();
+        let frame = Frame::reference(px).unwrap();
         let d = det.detect(&frame, &mut scratch).unwrap();
         assert!(scratch.work().deep_space().is_some(), "{d:?}");
         assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
-        let r = d.roi.expect("the cut target's box");
-        assert!(r.iou(&Roi::new(0, 100, 30, 150)) > 0.8, "{r:?}");
+        let r = d.roi.expect("the piece's box");
+        assert!(r.iou(&truth) > min_iou, "{r:?}");
         assert_eq!(
             d,
             det.detect(&frame, &mut scratch).unwrap(),
             "same answer twice"
         );
+    }
+
+    #[test]
+    fn a_target_cut_by_one_side_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let px = shaded_sky_with(0, 100, 30, 150, 200);
+        assert_border_piece(&px, Roi::new(0, 100, 30, 150), 0.8);
         // A rectangle cut by the top-left corner: its outline inside the frame is an L.
         let px = shaded_sky_with(0, 0, 30, 40, 200);
-        let frame = Frame::reference(&px).unwrap();
-        let d = det.detect(&frame, &mut scratch).unwrap();
-        assert!(scratch.work().deep_space().is_some(), "{d:?}");
-        assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
-        let r = d.roi.expect("the corner piece's box");
-        assert!(r.iou(&Roi::new(0, 0, 30, 40)) > 0.8, "{r:?}");
+        assert_border_piece(&px, Roi::new(0, 0, 30, 40), 0.8);
         // The Earth's disc (radius 700 px) cutting the same corner, as bright: its
         // boundary is one straight arc.
         let mut limb = shaded_sky(false, true);
@@ -2787,8 +2790,6 @@ mod tests {
     /// could (≤ 2.6 px): boxed.
     #[test]
     fn a_deep_piece_cut_by_one_side_is_no_limb() {
-        let det = AutoV2::default();
-        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
         let mut px = shaded_sky(false, true);
         for y in 90..150usize {
             for x in 0..40usize {
@@ -2798,10 +2799,7 @@ mod tests {
         let frame = Frame::reference(&px).unwrap();
         let truth = Roi::new(0, 90, 40, 150);
         assert!(limb::is_limb(&frame, truth), "the outline alone says limb");
-        let d = det.detect(&frame, &mut scratch).unwrap();
-        assert!(scratch.work().deep_space().is_some(), "{d:?}");
-        assert_eq!(d.score_permille, BORDER_PIECE_SCORE_PERMILLE, "{d:?}");
-        assert!(d.roi.expect("the piece's box").iou(&truth) > 0.7, "{d:?}");
+        assert_border_piece(&px, truth, 0.7);
     }
 
     /// A hot pixel alone in a clipped deep sky (0 DN but for it, as the real camera's
