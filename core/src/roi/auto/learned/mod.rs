@@ -2717,12 +2717,6 @@ mod tests {
         px
     }
 
-    /// Stage 2c at the window's border: a face brighter than the sky, cut by one side
-    /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], is boxed with
-    /// [`BORDER_PIECE_SCORE_PERMILLE`], and so is a rectangle in a corner (its outline
-    /// bends); a band along a whole side (as long as a piece of the Earth's disc), the
-    /// Earth's disc across a corner (one straight arc) and a face colder than the sky
-    /// (the sky of a corner, the rest Earth) are not the stage's.
     /// Asserts that stage 2c boxes `px` as a border piece ([`BORDER_PIECE_SCORE_PERMILLE`])
     /// with IoU above `min_iou` against `truth`, the same twice.
     fn assert_border_piece(px: &[u16], truth: Roi, min_iou: f32) {
@@ -2741,6 +2735,12 @@ mod tests {
         );
     }
 
+    /// Stage 2c at the window's border: a face brighter than the sky, cut by one side
+    /// and shorter along it than [`EARTH_MIN_CHORD_CELLS`], is boxed with
+    /// [`BORDER_PIECE_SCORE_PERMILLE`], and so is a rectangle in a corner (its outline
+    /// bends); a band along a whole side (as long as a piece of the Earth's disc), the
+    /// Earth's disc across a corner (one straight arc) and a face colder than the sky
+    /// (the sky of a corner, the rest Earth) are not the stage's.
     #[test]
     fn a_target_cut_by_one_side_over_a_shaded_sky_is_found_by_the_deep_space_stage() {
         let det = AutoV2::default();
