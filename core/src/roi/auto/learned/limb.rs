@@ -12,7 +12,7 @@
 //! only with 3 px of its level behind it and of the other level beyond (session 50), so
 //! hot pixels and cold specks off the arc do not break the fit.
 //!
-//! The converse, [`bends`] (session 53): a boundary far from every parabola is a
+//! The converse, [`Outline::Bends`] (session 53): a boundary far from every parabola is a
 //! target's corner or bend, never the disc's arc; stage 2c boxes a piece in a corner of
 //! deep space only when its outline bends, since the disc cut by a corner shows there
 //! too.
@@ -54,7 +54,7 @@ const MIN_BOUNDARY_PX: u32 = 8;
 pub const MAX_ARC_RMS2_PX2: f64 = 2.89;
 
 /// Smallest mean squared distance, px², of the boundary pixels from the fitted
-/// parabola for an outline that bends ([`bends`]): 6 × [`MAX_ARC_RMS2_PX2`] (4.2 px
+/// parabola for an outline that bends ([`Outline::Bends`]): 6 × [`MAX_ARC_RMS2_PX2`] (4.2 px
 /// rms). Between the largest non-target outline of family A (session 53, stage 2c's
 /// corner pieces of seeds 7001–7201: the paper world's limb in a corner, ragged by its
 /// noise, `paperA/000078`, 8.6 px², 3.0 ×) and the smallest target's corner piece that
@@ -71,17 +71,32 @@ pub const MIN_BEND_RMS2_PX2: f64 = 6.0 * MAX_ARC_RMS2_PX2;
 /// neighbours, 2·`BOUNDARY_DEPTH_PX` more where one is of the other level); 1 KiB
 /// of stack (the histogram).
 pub fn is_limb(frame: &Frame<'_>, roi: Roi) -> bool {
-    arc_rms2_px2(frame, roi).is_some_and(|rms2| rms2 <= MAX_ARC_RMS2_PX2)
+    outline(frame, roi) == Outline::Arc
 }
 
-/// Whether the boundary in `roi` (at the frame's border, as [`is_limb`] reads it)
-/// departs from every parabola by at least [`MIN_BEND_RMS2_PX2`]: an outline with a
-/// corner or a bend inside the box, which a piece of the Earth's disc cut by the frame
-/// (one nearly straight arc) never shows. `false` wherever [`is_limb`] finds no
-/// boundary to fit (a box off the border, too large, saturated, too few boundary
-/// pixels): the answer must be measured. Same cost as [`is_limb`].
-pub fn bends(frame: &Frame<'_>, roi: Roi) -> bool {
-    arc_rms2_px2(frame, roi).is_some_and(|rms2| rms2 >= MIN_BEND_RMS2_PX2)
+/// What the boundary in a box at the frame's border is ([`outline`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outline {
+    /// One arc: within [`MAX_ARC_RMS2_PX2`] of a parabola (the Earth's limb, or a single
+    /// straight edge).
+    Arc,
+    /// At least [`MIN_BEND_RMS2_PX2`] from every parabola: a corner or a bend inside the
+    /// box, which a piece of the Earth's disc cut by the frame (one nearly straight arc)
+    /// never shows.
+    Bends,
+    /// Between the two, or nothing to measure (a box off the border, too large,
+    /// saturated, with too few boundary pixels: see [`is_limb`]).
+    Unclear,
+}
+
+/// The boundary in `roi` read as [`is_limb`] reads it, classed by its mean squared
+/// distance from the best parabola ([`Outline`]). Same cost as [`is_limb`].
+pub fn outline(frame: &Frame<'_>, roi: Roi) -> Outline {
+    match arc_rms2_px2(frame, roi) {
+        Some(rms2) if rms2 <= MAX_ARC_RMS2_PX2 => Outline::Arc,
+        Some(rms2) if rms2 >= MIN_BEND_RMS2_PX2 => Outline::Bends,
+        _ => Outline::Unclear,
+    }
 }
 
 /// The mean squared distance, px², of the boundary pixels in `roi` from the best
@@ -375,12 +390,12 @@ mod tests {
         let corner = frame_of(|x, y| x < 30.0 && y < 40.0);
         let f = Frame::new(&corner, W, H, 14).unwrap();
         let b = roi(0, 0, 50, 60);
-        assert!(bends(&f, b) && !is_limb(&f, b));
+        assert_eq!(outline(&f, b), Outline::Bends);
         // The disc across the top-right corner: one arc.
         let (cx, cy, r) = (160.0 + 480.0, -480.0, 700.0);
         let disc = frame_of(|x, y| (x - cx).hypot(y - cy) < r);
         let f = Frame::new(&disc, W, H, 14).unwrap();
-        assert!(!bends(&f, roi(100, 0, 160, 50)));
+        assert_eq!(outline(&f, roi(100, 0, 160, 50)), Outline::Arc);
         // The same arc ragged by ±3 px every 8 px along it (a noisy limb, the paper
         // world's, 8.6 px² on family A): not an arc within 1.7 px, no bend either.
         let ragged = frame_of(|x, y| {
@@ -389,15 +404,16 @@ mod tests {
         });
         let f = Frame::new(&ragged, W, H, 14).unwrap();
         let b = roi(100, 0, 160, 50);
-        assert!(
-            !is_limb(&f, b) && !bends(&f, b),
+        assert_eq!(
+            outline(&f, b),
+            Outline::Unclear,
             "{:?}",
             arc_rms2_px2(&f, b)
         );
         // No boundary to measure: no bend.
         let flat = [1000u16; W * H];
         let g = Frame::new(&flat, W, H, 14).unwrap();
-        assert!(!bends(&g, b));
+        assert_eq!(outline(&g, b), Outline::Unclear);
     }
 
     #[test]

@@ -124,7 +124,7 @@ pub struct AutoV2 {
     /// [`DEEP_SPACE_SCORE_PERMILLE`], or [`BORDER_PIECE_SCORE_PERMILLE`] for cells cut
     /// by one side of the window that no piece of the Earth's disc could be
     /// ([`EARTH_MIN_CHORD_CELLS`]) or by a corner with an outline that bends
-    /// ([`limb::bends`]: the disc's is one arc). Otherwise, and when
+    /// ([`limb::Outline::Bends`]: the disc's is one arc). Otherwise, and when
     /// the frame has a saturated blob (stage 2b decides then), the classifier decides.
     /// Default on.
     pub deep_space: bool,
@@ -244,13 +244,18 @@ pub const EARTH_MIN_CHORD_CELLS: usize = 16;
 /// piece of the Earth's disc looks so ([`EARTH_MIN_CHORD_CELLS`]), a target cut by
 /// the frame does.
 fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
-    let on_vertical_side = w8.x0 == 0 || w8.x_end() >= pw;
-    let chord = if on_vertical_side {
+    let chord = if on_vertical_side(w8, pw) {
         w8.y_end().saturating_sub(usize::from(w8.y0))
     } else {
         w8.x_end().saturating_sub(usize::from(w8.x0))
     };
     w8.sides_touched((pw, ph)) == 1 && chord < EARTH_MIN_CHORD_CELLS
+}
+
+/// Whether cell box `w8` on a plane `pw` cells wide touches the left or right side (a
+/// piece cut by one side: its chord runs down that side).
+fn on_vertical_side(w8: CellStats, pw: usize) -> bool {
+    w8.x0 == 0 || w8.x_end() >= pw
 }
 
 /// The smallest radius of curvature of the Earth's limb in the image, px: the camera
@@ -272,8 +277,7 @@ pub const LIMB_DEPTH_SLACK_PX: u32 = 2;
 /// 0 → 0.84, `famAT/000251`, `000253`, `fixA/000042`), summed mean IoU 2.5176 →
 /// 2.5224, famAT 0.3768 → 0.3830, no false alarm added on any set.
 fn deeper_than_the_disc(r: Roi, w8: CellStats, (pw, _): (usize, usize)) -> bool {
-    let on_vertical_side = w8.x0 == 0 || w8.x_end() >= pw;
-    let (chord, depth) = if on_vertical_side {
+    let (chord, depth) = if on_vertical_side(w8, pw) {
         (u32::from(r.height()), u32::from(r.width()))
     } else {
         (u32::from(r.width()), u32::from(r.height()))
@@ -332,7 +336,7 @@ fn seeds_of<C: FrameCapacity>(work: &mut AutoV2Work<C>, n8: usize, root: u8) -> 
 /// corner of it: it touches two adjacent sides (not a band across the window) and is
 /// shorter than [`EARTH_MIN_CHORD_CELLS`] along both. The Earth's disc cut by a
 /// corner looks so too; its in-frame outline is one nearly straight arc, a target's
-/// bends ([`limb::bends`], tested on the refined box).
+/// bends ([`limb::Outline::Bends`], tested on the refined box).
 fn in_corner(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
     let (left, top, right, bottom) = (w8.x0 == 0, w8.y0 == 0, w8.x_end() >= pw, w8.y_end() >= ph);
     let across = w8.x_end().saturating_sub(usize::from(w8.x0));
@@ -387,11 +391,8 @@ pub const DEEP_SPACE_FINE_SIGMA: u16 = 6;
 /// `000119`, `famA/000084`, `famAT/000138`) or one pixel of a far target the spots then
 /// box whole (`famAF/000318`, `000330`); summed mean IoU 2.5083 → 2.5176, false alarms
 /// famA 1 → 0, famAE 10 → 8, famAT 1 → 0, famAT's IoU 0.3769 → 0.3768.
+/// Stage 2c's and 2d's boxes must reach it too, else the next stage decides.
 pub const MIN_BOX_SIDE_PX: u16 = 2;
-
-/// Stage 2c's box must be at least this many pixels on each side, else the classifier
-/// decides: a departure of one pixel across is a hot pixel.
-pub const DEEP_SPACE_MIN_SIDE_PX: u16 = 2;
 
 /// Tracking window margin around the prior, pixels, on top of the prior's longer side
 /// (`auto`'s default, room for a move of several pixels per frame). The window is
@@ -1663,7 +1664,7 @@ impl AutoV2 {
     /// [`EARTH_MIN_CHORD_CELLS`], departing upwards by at least
     /// [`BORDER_PIECE_MIN_CODE`], whose box is no limb, or one in a corner
     /// ([`in_corner`]) whose outline bends
-    /// ([`limb::bends`]): with [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier
+    /// ([`limb::Outline::Bends`]): with [`BORDER_PIECE_SCORE_PERMILLE`]); `None` (the classifier
     /// decides) when the window is not deep space, no cell departs, the component's
     /// strongest seed departs downwards (colder than deep space: the Earth read as
     /// smooth), the component touches the border otherwise, or the refinement finds no
@@ -1758,22 +1759,19 @@ impl AutoV2 {
         // space, its limb crossing the box): stage 4d's test, on the box carried to
         // the window's side the component touches (the refinement may stop a pixel
         // short of it), unless a piece cut by one side is deeper than the disc's.
-        if border
-            && d.roi.is_some_and(|r| {
-                let carried = to_touched_sides(r, w8, plane8, win);
-                (corner || !deeper_than_the_disc(carried, w8, plane8))
-                    && limb::is_limb(frame, carried)
-            })
-        {
-            return None;
-        }
         // A corner piece must show a target's bend (a disc's corner piece is one arc;
         // a box whose boundary cannot be measured is left to the classifier).
-        if corner
-            && !d
-                .roi
-                .is_some_and(|r| limb::bends(frame, to_touched_sides(r, w8, plane8, win)))
-        {
+        let carried = d.roi.map(|r| to_touched_sides(r, w8, plane8, win));
+        let limb_piece = match carried {
+            None => corner,
+            Some(c) if corner => limb::outline(frame, c) != limb::Outline::Bends,
+            Some(c) => {
+                border
+                    && !deeper_than_the_disc(c, w8, plane8)
+                    && limb::outline(frame, c) == limb::Outline::Arc
+            }
+        };
+        if limb_piece {
             return None;
         }
         // A box one pixel across is a hot pixel (the real camera's signature): no
@@ -1785,7 +1783,7 @@ impl AutoV2 {
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
                 .flatten();
         };
-        if r.x1 - r.x0 < DEEP_SPACE_MIN_SIDE_PX || r.y1 - r.y0 < DEEP_SPACE_MIN_SIDE_PX {
+        if r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX {
             // A hot pixel's cell: a small target may still be there (stage 2d).
             return self
                 .small_target
@@ -1803,7 +1801,7 @@ impl AutoV2 {
     /// Stage 2d ([`small`]) on a window stage 2c took for deep space without a target
     /// cell: the strongest small target's grown box with
     /// [`SMALL_TARGET_SCORE_PERMILLE`], or `None` (the classifier decides) when there is
-    /// none, its box grows too far or is under [`DEEP_SPACE_MIN_SIDE_PX`].
+    /// none, its box grows too far or is under [`MIN_BOX_SIDE_PX`].
     /// The integral planes (filled after stage 2c) lend the column sums.
     fn small_target_stage<C: FrameCapacity>(
         &self,
@@ -1822,7 +1820,7 @@ impl AutoV2 {
             work.sum_q.as_mut(),
         )?;
         let r = small::grown_box(frame, win, c, lv.sigma)?;
-        if r.x1 - r.x0 < DEEP_SPACE_MIN_SIDE_PX || r.y1 - r.y0 < DEEP_SPACE_MIN_SIDE_PX {
+        if r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX {
             return None;
         }
         work.deep_space = Some(seen);
