@@ -16,6 +16,10 @@
 //! target's corner or bend, never the disc's arc; stage 2c boxes a piece in a corner of
 //! deep space only when its outline bends, since the disc cut by a corner shows there
 //! too.
+//!
+//! The disc saturated by the camera (session 54, [`is_saturated_disc`]): in a corner,
+//! with deep space beyond it, the envelope of its bright level is one convex arc that
+//! sags visibly and bends no more than the limb can.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -32,6 +36,12 @@ const MAX_FRAME_SHARE_DIVISOR: usize = 4;
 /// (family A: saturated detection targets cut by the frame have straight edges too,
 /// their boxes 39–97 % saturated; the limb's were 0–1 %).
 const SATURATED_SHARE_DIVISOR: u32 = 10;
+
+/// Largest saturated box [`is_saturated_disc`] tests, as a share of the frame (1/2): the
+/// Earth's disc saturated and cut by a corner (famAE, session 54: the saturated blob's
+/// boxes 20 % and 28 % of the frame); its cost, three reads of each pixel of the box,
+/// stays under half a frame.
+const SATURATED_CORNER_SHARE_DIVISOR: usize = 2;
 
 /// How far, px, the region must go on behind a boundary pixel and the other level
 /// beyond it, within the box, for the pixel to count (3): a hot pixel in the deep sky
@@ -133,19 +143,7 @@ fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
         return None;
     }
     // Pass 2: Otsu's threshold on a histogram of the box.
-    let span = u32::from(hi - lo) + 1;
-    let bin = |v: u16| (u32::from(v - lo) * OTSU_BINS as u32 / span) as usize;
-    let mut hist = [0u32; OTSU_BINS];
-    for row in rows() {
-        for &v in row {
-            if let Some(c) = hist.get_mut(bin(v)) {
-                *c += 1;
-            }
-        }
-    }
-    let t_bin = otsu_bin(&hist)?;
-    // `bin(v) > t_bin` as one comparison: (v − lo)·256 / span ≥ t_bin + 1.
-    let above_dn = u32::from(lo) + ((t_bin as u32 + 1) * span).div_ceil(OTSU_BINS as u32);
+    let above_dn = otsu_dn(rows, (lo, hi))?;
     let above = |v: u16| u32::from(v) >= above_dn;
     // The region is the level the border sides of the box mostly show.
     let mut border = [0u32; 2];
@@ -209,6 +207,232 @@ fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
     Some(fit_x.residual2().min(fit_y.residual2()))
 }
 
+/// The lowest DN of the upper class of Otsu's threshold over the rows `rows` (DN
+/// range `lo..=hi`, `lo < hi`), from a histogram of [`OTSU_BINS`] bins; `None` with one
+/// occupied bin.
+fn otsu_dn<'a, I: Iterator<Item = &'a [u16]>>(
+    rows: impl Fn() -> I,
+    (lo, hi): (u16, u16),
+) -> Option<u32> {
+    let span = u32::from(hi.saturating_sub(lo)) + 1;
+    let bin = |v: u16| (u32::from(v.saturating_sub(lo)) * OTSU_BINS as u32 / span) as usize;
+    let mut hist = [0u32; OTSU_BINS];
+    for row in rows() {
+        for &v in row {
+            if let Some(c) = hist.get_mut(bin(v)) {
+                *c += 1;
+            }
+        }
+    }
+    let t_bin = otsu_bin(&hist)?;
+    // `bin(v) > t_bin` as one comparison: (v − lo)·256 / span ≥ t_bin + 1.
+    Some(u32::from(lo) + ((t_bin as u32 + 1) * span).div_ceil(OTSU_BINS as u32))
+}
+
+/// Whether `roi`, a box in a corner of the frame, is the Earth's disc saturated by the
+/// camera (session 54: two of famAE's last eight no-target false alarms, boxed by the
+/// saturated blob at 553 and 770 ‰): `false` unless the box lies in a corner (one
+/// vertical and one horizontal side of the frame), covers at most half the frame
+/// ([`SATURATED_CORNER_SHARE_DIVISOR`]) and is at least a tenth saturated. The disc's
+/// saturated part ends inside it where the limb darkens and its clouds cut holes, so
+/// the boundary [`is_limb`] fits is ragged; the disc's own edge is the envelope of the
+/// bright level (Otsu's in the box): per row, from the box's far side towards the
+/// frame's vertical side, the first bright pixel, and per column the same towards the
+/// horizontal side. The disc when, along rows or columns, deep space lies beyond that
+/// edge (the pixels [`SKY_BEYOND_PX`] past it average at most `sky_max_dn`, DN) and the
+/// edge is one convex arc of the disc ([`disc_edge`]: a parabola within
+/// [`MAX_ARC_RMS2_PX2`] bar isolated specks, bulging away from the corner, sagging at
+/// least [`DISC_MIN_SAG_PX`] and bending no more than the limb can). A saturated
+/// target in the corner shows corners, a straight edge or a tight round face; over
+/// the Earth, the Earth lies beyond it. Four passes over the box (range, histogram,
+/// the sky beyond, the fits); 1 KiB of stack (the histogram).
+pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
+    let (w, h) = (frame.width(), frame.height());
+    let (x0, y0, x1, y1) = (
+        usize::from(roi.x0),
+        usize::from(roi.y0),
+        usize::from(roi.x1),
+        usize::from(roi.y1),
+    );
+    let (left, right, top_side, bottom) = (x0 == 0, x1 == w, y0 == 0, y1 == h);
+    let in_corner = (left || right) && (top_side || bottom);
+    if x1 > w || y1 > h || x1 < x0 + 3 || y1 < y0 + 3 || !in_corner {
+        return false;
+    }
+    let area = (x1 - x0) * (y1 - y0);
+    if area * SATURATED_CORNER_SHARE_DIVISOR > w * h {
+        return false;
+    }
+    let rows = || (y0..y1).filter_map(|y| frame.row(y).and_then(|r| r.get(x0..x1)));
+    let top = frame.max_dn();
+    let (mut lo, mut hi, mut saturated) = (u16::MAX, 0u16, 0u32);
+    for row in rows() {
+        for &v in row {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            saturated += u32::from(v >= top);
+        }
+    }
+    if hi <= lo || saturated * SATURATED_SHARE_DIVISOR < area as u32 {
+        return false;
+    }
+    let Some(bright_dn) = otsu_dn(rows, (lo, hi)) else {
+        return false;
+    };
+    let pixels = frame.pixels();
+    let at = |x: usize, y: usize| pixels.get(y * w + x).map(|&v| u32::from(v));
+    let bright = |x: usize, y: usize| at(x, y).is_some_and(|v| v >= bright_dn);
+    let centre = |a: usize, lo: usize, hi: usize| a as f64 + 0.5 - (lo + hi) as f64 / 2.0;
+    // Per row, the edge's column: from the far side towards the frame's vertical side,
+    // the first bright pixel; a row bright to the far side (the disc goes on beyond the
+    // box) or without one is left out. Per column the same from the horizontal side.
+    let row_edge = |y: usize| {
+        if left {
+            (x0..x1)
+                .rev()
+                .find(|&x| bright(x, y))
+                .filter(|&x| x + 1 < x1)
+        } else {
+            (x0..x1).find(|&x| bright(x, y)).filter(|&x| x > x0)
+        }
+    };
+    let column_edge = |x: usize| {
+        if top_side {
+            (y0..y1)
+                .rev()
+                .find(|&y| bright(x, y))
+                .filter(|&y| y + 1 < y1)
+        } else {
+            (y0..y1).find(|&y| bright(x, y)).filter(|&y| y > y0)
+        }
+    };
+    // Beyond the disc's edge is deep space: the pixels [`SKY_BEYOND_PX`] past each
+    // edge point (inside the box) average no warmer than `sky_max_dn` (a saturated
+    // target's piece over the Earth has the Earth beyond it).
+    let (mut sky_sum, mut sky_n) = (0u64, 0u64);
+    let mut sky = |v: Option<u32>| {
+        if let Some(v) = v {
+            sky_sum += u64::from(v);
+            sky_n += 1;
+        }
+    };
+    for y in y0..y1 {
+        let beyond = row_edge(y).and_then(|x| {
+            if left {
+                Some(x + SKY_BEYOND_PX)
+            } else {
+                x.checked_sub(SKY_BEYOND_PX)
+            }
+        });
+        sky(beyond
+            .filter(|x| (x0..x1).contains(x))
+            .and_then(|x| at(x, y)));
+    }
+    for x in x0..x1 {
+        let beyond = column_edge(x).and_then(|y| {
+            if top_side {
+                Some(y + SKY_BEYOND_PX)
+            } else {
+                y.checked_sub(SKY_BEYOND_PX)
+            }
+        });
+        sky(beyond
+            .filter(|y| (y0..y1).contains(y))
+            .and_then(|y| at(x, y)));
+    }
+    if sky_sum
+        .checked_div(sky_n)
+        .is_none_or(|m| m > u64::from(sky_max_dn))
+    {
+        return false;
+    }
+    let rows_fit =
+        (y0..y1).filter_map(|y| row_edge(y).map(|x| (centre(y, y0, y1), centre(x, x0, x1))));
+    let columns_fit =
+        (x0..x1).filter_map(|x| column_edge(x).map(|y| (centre(x, x0, x1), centre(y, y0, y1))));
+    // The disc's bright region is convex: its edge bulges away from the corner.
+    let away = |towards_high: bool| if towards_high { 1.0 } else { -1.0 };
+    disc_edge(rows_fit, away(left)) || disc_edge(columns_fit, away(top_side))
+}
+
+/// How far past the disc's edge [`is_saturated_disc`] reads the sky, px: beyond the
+/// blur of the edge (the optics' spread, 1–2 px).
+const SKY_BEYOND_PX: usize = 4;
+
+/// Points farther than this from the first parabola, px, are strays (a hot pixel in
+/// the sky beyond the disc, a bright speck): 3 px, the reach [`BOUNDARY_DEPTH_PX`]
+/// gives the other fit.
+const STRAY_PX: f64 = 3.0;
+
+/// At most one point in this many may be a stray ([`STRAY_PX`]): a few hot pixels,
+/// not a target's outline.
+const MAX_STRAY_DIVISOR: f64 = 10.0;
+
+/// Whether the points (`u`, `v`, in order along `u`) are the disc's edge: they follow
+/// one parabola of `v` on `u` (at least [`MIN_BOUNDARY_PX`] of them, at most a tenth
+/// farther than [`STRAY_PX`] from the first fit and no two of those in a row: specks,
+/// not a run of the outline; the others refitted within [`MAX_ARC_RMS2_PX2`]), which
+/// bulges towards increasing `v` when `bulge` is positive (the bright region convex,
+/// as a disc is) and decreasing `v` when it is negative, visibly
+/// ([`DISC_MIN_SAG_PX`] over its chord: a target's straight edge does not bend) and no
+/// more than the disc's limb can ([`DISC_CURVATURE_SLACK`]).
+fn disc_edge(points: impl Iterator<Item = (f64, f64)> + Clone, bulge: f64) -> bool {
+    let mut all = ParabolaSums::default();
+    points.clone().for_each(|(u, v)| all.add(u, v));
+    let Some((a, b, c)) = all.coefficients() else {
+        return false;
+    };
+    // Squared distance across the curve, as `residual2` measures it.
+    let off2 = |u: f64, v: f64| {
+        let d = v - (a + b * u + c * u * u);
+        d * d / (1.0 + b * b)
+    };
+    let mut kept = ParabolaSums::default();
+    let (mut u_lo, mut u_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut last_stray = false;
+    for (u, v) in points {
+        let stray = off2(u, v) > STRAY_PX * STRAY_PX;
+        // Two strays in a row are a run of the outline off the arc (a corner), not
+        // a speck.
+        if stray && last_stray {
+            return false;
+        }
+        if !stray {
+            kept.add(u, v);
+            u_lo = u_lo.min(u);
+            u_hi = u_hi.max(u);
+        }
+        last_stray = stray;
+    }
+    let follows = kept.n >= f64::from(MIN_BOUNDARY_PX)
+        && (all.n - kept.n) * MAX_STRAY_DIVISOR <= all.n
+        && kept.residual2() <= MAX_ARC_RMS2_PX2;
+    let Some((_, b, c)) = kept.coefficients().filter(|_| follows) else {
+        return false;
+    };
+    // At the box's centre: curvature 2|c| / (1 + b²)^(3/2); the sag across the chord
+    // of length L along `u`, |c| · L² / (4 √(1 + b²)). Both compared squared.
+    let slope2 = 1.0 + b * b;
+    let chord = u_hi - u_lo;
+    let max_curvature = DISC_CURVATURE_SLACK / f64::from(super::EARTH_MIN_LIMB_RADIUS_PX);
+    c * bulge < 0.0
+        && 4.0 * c * c <= max_curvature * max_curvature * slope2 * slope2 * slope2
+        && c * c * chord * chord * chord * chord
+            >= 16.0 * DISC_MIN_SAG_PX * DISC_MIN_SAG_PX * slope2
+}
+
+/// How much more the fitted edge may bend than the disc's tightest limb
+/// ([`super::EARTH_MIN_LIMB_RADIUS_PX`]): 2, for the fit's own noise; a target's
+/// rounded vertex in a corner (famAT/000204, a Tango face's tip 31 px across, radius
+/// 11–15 px) bends far more, and a parabola follows it within [`MAX_ARC_RMS2_PX2`].
+const DISC_CURVATURE_SLACK: f64 = 2.0;
+
+/// Least sag of the disc's edge across its chord, px: 1. A saturated panel's straight
+/// edge in a corner over deep space (famBW/000725, held out) fits a parabola too, with
+/// none; the saturated disc's pieces of famAE (session 54) sag 2.7 and 5.6 px (radii
+/// 1 190 and 914 px over chords of 160 and 200 px).
+const DISC_MIN_SAG_PX: f64 = 1.0;
+
 /// The bin of Otsu's threshold (the last bin of the lower class) over `hist`; `None`
 /// with one occupied bin.
 fn otsu_bin(hist: &[u32; OTSU_BINS]) -> Option<usize> {
@@ -264,9 +488,9 @@ impl ParabolaSums {
         self.v2 += v * v;
     }
 
-    /// The mean squared distance of the points from the best parabola, px², across
-    /// it (∞ when `u` takes fewer than three values: no parabola of `v` on `u`).
-    fn residual2(&self) -> f64 {
+    /// The best parabola's `(a, b, c)`; `None` when `u` takes fewer than three values
+    /// (no parabola of `v` on `u`).
+    fn coefficients(&self) -> Option<(f64, f64, f64)> {
         let m = [
             [self.n, self.u, self.u2],
             [self.u, self.u2, self.u3],
@@ -275,7 +499,7 @@ impl ParabolaSums {
         let b = [self.v, self.uv, self.u2v];
         let det = det3(&m);
         if det.is_nan() || det.abs() <= 1e-9 * self.n.max(1.0) {
-            return f64::INFINITY;
+            return None;
         }
         // Cramer's rule: each coefficient from `m` with one column replaced by `b`.
         let coef = |k: usize| {
@@ -287,7 +511,15 @@ impl ParabolaSums {
             }
             det3(&mk) / det
         };
-        let (a, b1, c) = (coef(0), coef(1), coef(2));
+        Some((coef(0), coef(1), coef(2)))
+    }
+
+    /// The mean squared distance of the points from the best parabola, px², across
+    /// it (∞ when `u` takes fewer than three values: no parabola of `v` on `u`).
+    fn residual2(&self) -> f64 {
+        let Some((a, b1, c)) = self.coefficients() else {
+            return f64::INFINITY;
+        };
         let rss = self.v2 - (a * self.v + b1 * self.uv + c * self.u2v);
         // From distances along `v` to distances across the curve (its slope at the
         // box's centre): a slanted line's points lie √(1 + b²) farther along `v`.
@@ -433,5 +665,73 @@ mod tests {
         let flat = [1000u16; W * H];
         let g = Frame::new(&flat, W, H, 14).unwrap();
         assert!(!is_limb(&g, roi(100, 0, 160, 50)));
+    }
+
+    /// A 14-bit frame: deep space at `sky` DN, saturated (16 383) where `bright(x, y)`.
+    fn saturated_of(bright: impl Fn(f64, f64) -> bool, sky: u16) -> [u16; W * H] {
+        let mut px = frame_of(bright);
+        for v in px.iter_mut() {
+            *v = if *v == 6000 { 16383 } else { sky };
+        }
+        px
+    }
+
+    /// The disc of 700 px radius across the top-left corner: its edge runs from (0, 77)
+    /// to (77, 0), a chord of 109 px that sags 2.1 px.
+    fn disc(x: f64, y: f64) -> bool {
+        (x + 455.0).hypot(y + 455.0) < 700.0
+    }
+
+    /// Deep space beyond the disc's edge: 1 000 DN plus a margin.
+    const SKY_MAX_DN: u32 = 1500;
+
+    #[test]
+    fn a_saturated_disc_in_a_corner_is_the_earth() {
+        let mut px = saturated_of(disc, 1000);
+        // Clouds below saturation inside the disc (holes in the saturated region, some
+        // at its edge) and a hot pixel in the sky beyond it.
+        for &(x, y) in &[(10, 10), (30, 20), (50, 8), (20, 50), (40, 30), (60, 10)] {
+            for dy in 0..4 {
+                for dx in 0..4 {
+                    px[(y + dy) * W + x + dx] = 12_000;
+                }
+            }
+        }
+        px[40 * W + 85] = 16383;
+        let f = Frame::new(&px, W, H, 14).unwrap();
+        let b = roi(0, 0, 90, 90);
+        assert!(is_saturated_disc(&f, b, SKY_MAX_DN));
+        // The saturated region's own boundary is ragged: the limb test does not see it.
+        assert!(!is_limb(&f, b));
+        // The same disc with a warm level beyond it (the Earth around a target's piece).
+        let warm = saturated_of(disc, 9000);
+        let g = Frame::new(&warm, W, H, 14).unwrap();
+        assert!(!is_saturated_disc(&g, b, SKY_MAX_DN));
+        // Along one side only (not a corner), or larger than half the frame: not tested.
+        assert!(!is_saturated_disc(&f, roi(0, 5, 90, 95), SKY_MAX_DN));
+        assert!(!is_saturated_disc(&f, roi(0, 0, 130, 90), SKY_MAX_DN));
+    }
+
+    #[test]
+    fn a_saturated_target_in_a_corner_is_not_the_disc() {
+        let b = roi(0, 0, 90, 90);
+        let not_disc = |bright: &dyn Fn(f64, f64) -> bool, what: &str| {
+            let px = saturated_of(bright, 1000);
+            let f = Frame::new(&px, W, H, 14).unwrap();
+            assert!(!is_saturated_disc(&f, b, SKY_MAX_DN), "{what}");
+        };
+        not_disc(&|x, y| x < 40.0 && y < 50.0, "a rectangle's corner");
+        // A nearly straight edge (a radius of 20 000 px, as a panel's: it sags 0.07 px
+        // across the same chord as the disc's).
+        not_disc(
+            &|x, y| (x + 14_103.6).hypot(y + 14_103.6) < 20_000.0,
+            "a straight edge (no sag)",
+        );
+        not_disc(
+            &|x, y| (x - 5.0).hypot(y - 5.0) < 30.0,
+            "a tight round face",
+        );
+        // Bulging towards the corner (the bright region concave): no disc.
+        not_disc(&|x, y| (x - 532.0).hypot(y - 532.0) > 700.0, "concave");
     }
 }

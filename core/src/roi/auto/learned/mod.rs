@@ -252,6 +252,17 @@ fn cut_by_one_side(w8: CellStats, (pw, ph): (usize, usize)) -> bool {
     w8.sides_touched((pw, ph)) == 1 && chord < EARTH_MIN_CHORD_CELLS
 }
 
+/// Stage 4d's test: whether box `r` is the Earth at the frame's border, its limb
+/// ([`limb::is_limb`]) or its disc saturated in a corner ([`limb::is_saturated_disc`],
+/// deep space beyond it no warmer than [`SKY_RANGE_DIVISOR`] and [`SKY_NOISE_SIGMAS`]
+/// allow over the frame's levels `lv`).
+fn earth_at_border(frame: &Frame<'_>, r: Roi, lv: &FrameLevels) -> bool {
+    let sky_max_dn = u32::from(lv.p2)
+        + (u32::from(lv.p50.saturating_sub(lv.p2)) / SKY_RANGE_DIVISOR)
+            .max(SKY_NOISE_SIGMAS * lv.sigma);
+    limb::is_limb(frame, r) || limb::is_saturated_disc(frame, r, sky_max_dn)
+}
+
 /// Whether cell box `w8` on a plane `pw` cells wide touches the left or right side (a
 /// piece cut by one side: its chord runs down that side).
 fn on_vertical_side(w8: CellStats, pw: usize) -> bool {
@@ -492,6 +503,18 @@ enum Counts {
     /// Overwritten by stage 3: counted again ([`blob::saturated_counts`]).
     Recount,
 }
+
+/// Deep space beyond a saturated disc ([`limb::is_saturated_disc`]) is no warmer than
+/// the frame's 2nd percentile of cell means plus a quarter of the way to their median:
+/// the sky is the frame's coldest level, the Earth beside a saturated target's piece
+/// lies at the clouds' (famA/000348: a target's saturated sliver in a corner over the
+/// Earth, an edge as straight as the limb's).
+const SKY_RANGE_DIVISOR: u32 = 4;
+
+/// ... and at least this many pixel noise σ above that percentile (a frame mostly deep
+/// space has its median there too; the sky read past the disc's edge carries the
+/// edge's blur and the noise: famAE/000018, 2.1 σ above the clipped sky, session 54).
+const SKY_NOISE_SIGMAS: u32 = 3;
 
 /// Relabelling step of the classifier's and stage 2c's cell codes when their cells
 /// need more labels than there are (codes are quarter units of log-odds: 2 units).
@@ -1602,7 +1625,7 @@ impl AutoV2 {
         // no target (stage 5e's spots may still answer). A candidate under the gate stays
         // one: a target entering the frame shows one straight edge too, and the sequence
         // tracker confirms a candidate by its motion against the ground.
-        if d.roi.is_some_and(|r| limb::is_limb(frame, r)) {
+        if d.roi.is_some_and(|r| earth_at_border(frame, r, &lv)) {
             work.winner = None;
             return NO_TARGET;
         }
@@ -1857,7 +1880,14 @@ impl AutoV2 {
         // The blob's labels again (stage 3 overwrote them): the same frame, the same
         // labels and confidence.
         let (winner, score) = self.blob_stage(frame, work, win, plane8, lv, Counts::Recount)?;
-        Some(self.finish_blob(frame, work, win, plane8, lv, winner, score))
+        let d = self.finish_blob(frame, work, win, plane8, lv, winner, score);
+        // Stage 4d for the blob too (session 54): the saturated Earth's disc cut by a
+        // corner of the frame is no target (stage 5e's spots may still answer).
+        if d.roi.is_some_and(|r| earth_at_border(frame, r, &lv)) {
+            work.winner = None;
+            return Some(NO_TARGET);
+        }
+        Some(d)
     }
 
     /// Stages 5–8 on the blob's winner; below the gate, no target.
@@ -2820,6 +2850,45 @@ mod tests {
             det.detect(&frame, &mut scratch).unwrap(),
             "same answer twice"
         );
+    }
+
+    /// Stage 4d's saturated disc (`limb::is_saturated_disc`): the disc of 700 px radius
+    /// saturated across the top-left corner of a deep-space frame, with clouds below
+    /// saturation in it, is no target; a saturated block cut by the same corner (its
+    /// corner bends) is boxed.
+    #[test]
+    fn a_saturated_disc_in_a_corner_is_no_target() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let top = (1u16 << crate::frame::DEFAULT_BIT_DEPTH) - 1;
+        let with = |bright: &dyn Fn(f32, f32) -> bool| {
+            let mut px = blocks_frame(&[]);
+            for (i, v) in px.iter_mut().enumerate() {
+                let (x, y) = ((i % FRAME_WIDTH) as f32, (i / FRAME_WIDTH) as f32);
+                if bright(x + 0.5, y + 0.5) {
+                    // Clouds: 6-px patches every 24 px, below saturation.
+                    let cloud = (x as usize % 24) < 6 && (y as usize % 24) < 6;
+                    *v = if cloud { 12_000 } else { top };
+                }
+            }
+            px
+        };
+        // Its edge runs from (0, 150) to (150, 0).
+        let px = with(&|x, y| (x + 400.0).hypot(y + 400.0) < 700.0);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().blob().is_some(), "{d:?}");
+        assert_eq!(d.roi, None, "{d:?}");
+        assert_eq!(
+            d,
+            det.detect(&frame, &mut scratch).unwrap(),
+            "same answer twice"
+        );
+        let px = with(&|x, y| x < 100.0 && y < 80.0);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        let r = d.roi.expect("the block is boxed");
+        assert!(r.x1 >= 96 && r.y1 >= 76 && r.x0 == 0 && r.y0 == 0, "{d:?}");
     }
 
     /// Stage 2c: a face colder than the fitted sky inside the window is no target over
