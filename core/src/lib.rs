@@ -67,7 +67,7 @@
 //! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
 //! A sequence tracker ([`roi::track::Tracker`]: `auto-v2` over consecutive frames)
 //! keeps its own state beside `auto-v2`'s scratch: [`roi::track::TRACKER_BYTES`] =
-//! 8 392 (budget 9 KiB).
+//! 8 400 (budget 9 KiB).
 //!
 //! ## Frame capacity
 //!

@@ -1392,7 +1392,7 @@ fn scratch_memory_is_as_documented_on_64_bit() {
     // The sequence tracker's own state (lib.rs, docs/detectors.md).
     assert_eq!(
         tirroi_core::roi::track::TRACKER_BYTES,
-        8_392,
+        8_400,
         "lib.rs: TRACKER_BYTES"
     );
 }

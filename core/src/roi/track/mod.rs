@@ -10,8 +10,10 @@
 //! ([`AutoV2::candidate_floor_permille`]) and the ground's shift between frames
 //! ([`ground`], block matching of 16 patches), and confirms a candidate that followed
 //! itself ([`crate::roi::auto::learned`]'s fast path's rule: IoU ≥ 0.3, every side
-//! within 4 px + 10 %) over [`CONFIRM_FRAMES`] frames while its centre moved at least
-//! [`CONFIRM_MOVE_PX`] px per frame net of the ground's motion ([`Confirmation`]).
+//! within 4 px + 10 %) over [`CONFIRM_FRAMES`] frames while its box moved at least
+//! [`CONFIRM_MOVE_PX`] px per frame net of the ground's motion, both of its opposite
+//! sides the same way ([`Confirmation`]; until session 54 its centre, which stands
+//! still when one side follows the ground and the other shrinks).
 //! A confirmed box is answered with [`CONFIRMED_SCORE_PERMILLE`] and tracked from
 //! then on as any box. The rule was found offline (`scripts/sequence-confirmation.py`,
 //! `docs/detectors.md` § Session 42) and chosen on family A's approach sequences.
@@ -123,9 +125,9 @@ pub struct Confirmation {
     last: Option<Roi>,
     /// Frames in the run, the last candidate's included.
     frames: u8,
-    /// Net motion of the candidate's centre against the ground over the run, half px
-    /// (x, y).
-    net_half_px: (i32, i32),
+    /// Net motion of each side of the candidate's box against the ground over the run,
+    /// px (left, top, right, bottom).
+    net_px: [i32; 4],
 }
 
 impl Confirmation {
@@ -133,7 +135,7 @@ impl Confirmation {
     pub const NONE: Confirmation = Confirmation {
         last: None,
         frames: 0,
-        net_half_px: (0, 0),
+        net_px: [0; 4],
     };
 
     /// A run of one frame: `now`.
@@ -141,7 +143,7 @@ impl Confirmation {
         *self = Confirmation {
             last: Some(now),
             frames: 1,
-            net_half_px: (0, 0),
+            net_px: [0; 4],
         };
     }
 
@@ -149,7 +151,13 @@ impl Confirmation {
     /// since the last frame (`Some(None)`: measured, no agreement — taken as no motion,
     /// as deep space shows; `None`: not measured, the run restarts); whether the run
     /// now confirms it: [`CONFIRM_FRAMES`] frames or more, and a net motion against the
-    /// ground of [`CONFIRM_MOVE_PX`] px or more per frame (`params`' values).
+    /// ground of [`CONFIRM_MOVE_PX`] px or more per frame (`params`' values), the box's
+    /// motion per axis being the lesser of its two opposite sides' net motions when
+    /// both went the same way, else none. A box that grows or shrinks in place does not
+    /// move; nor does a cold cloud's box on a sliding ground whose one side follows the
+    /// ground while the other is held by the camera's fixed shading (session 54: such a
+    /// centre stood still against a ground moving 2.5 px per frame and confirmed a
+    /// cloud, `famASE` sequence 8, tracked for 20 frames).
     pub fn update(
         &mut self,
         candidate: Option<Roi>,
@@ -163,11 +171,11 @@ impl Confirmation {
         match (self.last, shift) {
             (Some(last), Some(shift)) if follows_prior(&last, &now) => {
                 let (gx, gy) = shift.map_or((0, 0), |s| (i32::from(s.dx_px), i32::from(s.dy_px)));
-                let centre_moved = |a0: u16, a1: u16, b0: u16, b1: u16| {
-                    i32::from(b0) + i32::from(b1) - i32::from(a0) - i32::from(a1)
-                };
-                self.net_half_px.0 += centre_moved(last.x0, last.x1, now.x0, now.x1) - 2 * gx;
-                self.net_half_px.1 += centre_moved(last.y0, last.y1, now.y0, now.y1) - 2 * gy;
+                let moved = |a: u16, b: u16, g: i32| i32::from(b) - i32::from(a) - g;
+                self.net_px[0] += moved(last.x0, now.x0, gx);
+                self.net_px[1] += moved(last.y0, now.y0, gy);
+                self.net_px[2] += moved(last.x1, now.x1, gx);
+                self.net_px[3] += moved(last.y1, now.y1, gy);
                 self.frames = self.frames.saturating_add(1);
             }
             _ => self.restart(now),
@@ -176,9 +184,19 @@ impl Confirmation {
         if self.frames < params.frames {
             return false;
         }
-        // |net| / moves ≥ CONFIRM_MOVE_PX, in half px, squared (no root, no division).
-        let (x, y) = (i64::from(self.net_half_px.0), i64::from(self.net_half_px.1));
-        let least = 2 * i64::from(params.move_px) * i64::from(self.frames - 1);
+        // The box moved when both its opposite sides moved the same way: the lesser of
+        // the two per axis (a box whose one side follows the ground while the other
+        // shrinks, a cloud cut by a fixed shading, did not move).
+        let both = |a: i32, b: i32| {
+            if (a > 0 && b > 0) || (a < 0 && b < 0) {
+                i64::from(a.abs().min(b.abs()))
+            } else {
+                0
+            }
+        };
+        let [left, top, right, bottom] = self.net_px;
+        let (x, y) = (both(left, right), both(top, bottom));
+        let least = i64::from(params.move_px) * i64::from(self.frames - 1);
         x * x + y * y >= least * least
     }
 }
@@ -315,6 +333,30 @@ mod tests {
         assert!(!run.update(Some(at(102, 50)), SHIFT(0, 0), &p));
         assert!(run.update(Some(at(104, 50)), SHIFT(0, 0), &p));
         assert!(run.update(Some(at(106, 50)), SHIFT(0, 0), &p));
+    }
+
+    /// A box whose left side follows the ground (2.5 px per frame) while its right side
+    /// shrinks back (a cloud held by the camera's shading): its centre stands still
+    /// against the ground, but the box did not move; a box moving whole the same way
+    /// against a still ground is confirmed.
+    #[test]
+    fn a_box_whose_sides_part_ways_is_not_confirmed() {
+        let p = ConfirmParams::DEFAULT;
+        let mut run = Confirmation::NONE;
+        let boxes = [(126, 177), (129, 176), (131, 172), (134, 170)];
+        for (k, &(x0, x1)) in boxes.iter().enumerate() {
+            let s = if k == 0 { None } else { SHIFT(3, 0) };
+            assert!(
+                !run.update(Some(Roi::new(x0, 99, x1, 157)), s, &p),
+                "frame {k}"
+            );
+        }
+        let mut whole = Confirmation::NONE;
+        for (k, x0) in [100u16, 98, 96].into_iter().enumerate() {
+            let s = if k == 0 { None } else { SHIFT(0, 0) };
+            let confirmed = whole.update(Some(Roi::new(x0, 99, x0 + 40, 157)), s, &p);
+            assert_eq!(confirmed, k == 2, "frame {k}");
+        }
     }
 
     /// A cloud cell moves with the ground: never confirmed, however long it follows
