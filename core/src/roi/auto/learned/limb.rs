@@ -109,20 +109,25 @@ pub fn outline(frame: &Frame<'_>, roi: Roi) -> Outline {
     }
 }
 
-/// The mean squared distance, px², of the boundary pixels in `roi` from the best
-/// parabola (the lesser of `y` on `x` and `x` on `y`); `None` where [`is_limb`] says
-/// `false` before fitting (see there).
-fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
-    let (w, h) = (frame.width(), frame.height());
+/// `roi`'s ends `(x0, y0, x1, y1)`, px, when it lies in the frame and spans at least
+/// 3 px each way (a boundary with a pixel on either side); `None` otherwise.
+fn measurable(frame: &Frame<'_>, roi: Roi) -> Option<(usize, usize, usize, usize)> {
     let (x0, y0, x1, y1) = (
         usize::from(roi.x0),
         usize::from(roi.y0),
         usize::from(roi.x1),
         usize::from(roi.y1),
     );
-    if x1 > w || y1 > h || x1 < x0 + 3 || y1 < y0 + 3 {
-        return None;
-    }
+    let inside = x1 <= frame.width() && y1 <= frame.height();
+    (inside && x1 >= x0 + 3 && y1 >= y0 + 3).then_some((x0, y0, x1, y1))
+}
+
+/// The mean squared distance, px², of the boundary pixels in `roi` from the best
+/// parabola (the lesser of `y` on `x` and `x` on `y`); `None` where [`is_limb`] says
+/// `false` before fitting (see there).
+fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
+    let (w, h) = (frame.width(), frame.height());
+    let (x0, y0, x1, y1) = measurable(frame, roi)?;
     let on_border = [x0 == 0, y0 == 0, x1 == w, y1 == h];
     let area = (x1 - x0) * (y1 - y0);
     if !on_border.contains(&true) || area * MAX_FRAME_SHARE_DIVISOR > w * h {
@@ -130,15 +135,7 @@ fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
     }
     let rows = || (y0..y1).filter_map(|y| frame.row(y).and_then(|r| r.get(x0..x1)));
     // Pass 1: the box's range and its saturated pixels.
-    let top = frame.max_dn();
-    let (mut lo, mut hi, mut saturated) = (u16::MAX, 0u16, 0u32);
-    for row in rows() {
-        for &v in row {
-            lo = lo.min(v);
-            hi = hi.max(v);
-            saturated += u32::from(v >= top);
-        }
-    }
+    let (lo, hi, saturated) = range_and_saturated(rows(), frame.max_dn());
     if hi <= lo || saturated * SATURATED_SHARE_DIVISOR >= area as u32 {
         return None;
     }
@@ -207,6 +204,14 @@ fn arc_rms2_px2(frame: &Frame<'_>, roi: Roi) -> Option<f64> {
     Some(fit_x.residual2().min(fit_y.residual2()))
 }
 
+/// The lowest and the highest DN of `rows` and how many of their pixels are at `top`
+/// (the frame's top DN): `(u16::MAX, 0, 0)` without a pixel.
+fn range_and_saturated<'a>(rows: impl Iterator<Item = &'a [u16]>, top: u16) -> (u16, u16, u32) {
+    rows.flatten().fold((u16::MAX, 0, 0), |(lo, hi, n), &v| {
+        (lo.min(v), hi.max(v), n + u32::from(v >= top))
+    })
+}
+
 /// The lowest DN of the upper class of Otsu's threshold over the rows `rows` (DN
 /// range `lo..=hi`, `lo < hi`), from a histogram of [`OTSU_BINS`] bins; `None` with one
 /// occupied bin.
@@ -248,15 +253,11 @@ fn otsu_dn<'a, I: Iterator<Item = &'a [u16]>>(
 /// the sky beyond, the fits); 1 KiB of stack (the histogram).
 pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
     let (w, h) = (frame.width(), frame.height());
-    let (x0, y0, x1, y1) = (
-        usize::from(roi.x0),
-        usize::from(roi.y0),
-        usize::from(roi.x1),
-        usize::from(roi.y1),
-    );
+    let Some((x0, y0, x1, y1)) = measurable(frame, roi) else {
+        return false;
+    };
     let (left, right, top_side, bottom) = (x0 == 0, x1 == w, y0 == 0, y1 == h);
-    let in_corner = (left || right) && (top_side || bottom);
-    if x1 > w || y1 > h || x1 < x0 + 3 || y1 < y0 + 3 || !in_corner {
+    if !((left || right) && (top_side || bottom)) {
         return false;
     }
     let area = (x1 - x0) * (y1 - y0);
@@ -264,15 +265,7 @@ pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
         return false;
     }
     let rows = || (y0..y1).filter_map(|y| frame.row(y).and_then(|r| r.get(x0..x1)));
-    let top = frame.max_dn();
-    let (mut lo, mut hi, mut saturated) = (u16::MAX, 0u16, 0u32);
-    for row in rows() {
-        for &v in row {
-            lo = lo.min(v);
-            hi = hi.max(v);
-            saturated += u32::from(v >= top);
-        }
-    }
+    let (lo, hi, saturated) = range_and_saturated(rows(), frame.max_dn());
     if hi <= lo || saturated * SATURATED_SHARE_DIVISOR < area as u32 {
         return false;
     }
@@ -283,63 +276,36 @@ pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
     let at = |x: usize, y: usize| pixels.get(y * w + x).map(|&v| u32::from(v));
     let bright = |x: usize, y: usize| at(x, y).is_some_and(|v| v >= bright_dn);
     let centre = |a: usize, lo: usize, hi: usize| a as f64 + 0.5 - (lo + hi) as f64 / 2.0;
-    // Per row, the edge's column: from the far side towards the frame's vertical side,
-    // the first bright pixel; a row bright to the far side (the disc goes on beyond the
-    // box) or without one is left out. Per column the same from the horizontal side.
-    let row_edge = |y: usize| {
-        if left {
-            (x0..x1)
-                .rev()
-                .find(|&x| bright(x, y))
-                .filter(|&x| x + 1 < x1)
+    // Per row, the edge's column: from the box's far side towards the frame's vertical
+    // side, the first bright pixel; a row bright to the far side (the disc goes on
+    // beyond the box) or without one is left out. Per column the same towards the
+    // horizontal side. `beyond`: the pixel `SKY_BEYOND_PX` past the edge, if in the box.
+    let row_edge = |y: usize| edge(x0..x1, left, |x| bright(x, y));
+    let column_edge = |x: usize| edge(y0..y1, top_side, |y| bright(x, y));
+    let beyond = |e: usize, (lo, hi): (usize, usize), from_low: bool| {
+        if from_low {
+            Some(e + SKY_BEYOND_PX)
         } else {
-            (x0..x1).find(|&x| bright(x, y)).filter(|&x| x > x0)
+            e.checked_sub(SKY_BEYOND_PX)
         }
+        .filter(|b| (lo..hi).contains(b))
     };
-    let column_edge = |x: usize| {
-        if top_side {
-            (y0..y1)
-                .rev()
-                .find(|&y| bright(x, y))
-                .filter(|&y| y + 1 < y1)
-        } else {
-            (y0..y1).find(|&y| bright(x, y)).filter(|&y| y > y0)
-        }
-    };
-    // Beyond the disc's edge is deep space: the pixels [`SKY_BEYOND_PX`] past each
-    // edge point (inside the box) average no warmer than `sky_max_dn` (a saturated
-    // target's piece over the Earth has the Earth beyond it).
-    let (mut sky_sum, mut sky_n) = (0u64, 0u64);
-    let mut sky = |v: Option<u32>| {
-        if let Some(v) = v {
-            sky_sum += u64::from(v);
-            sky_n += 1;
-        }
-    };
-    for y in y0..y1 {
-        let beyond = row_edge(y).and_then(|x| {
-            if left {
-                Some(x + SKY_BEYOND_PX)
-            } else {
-                x.checked_sub(SKY_BEYOND_PX)
-            }
-        });
-        sky(beyond
-            .filter(|x| (x0..x1).contains(x))
-            .and_then(|x| at(x, y)));
-    }
-    for x in x0..x1 {
-        let beyond = column_edge(x).and_then(|y| {
-            if top_side {
-                Some(y + SKY_BEYOND_PX)
-            } else {
-                y.checked_sub(SKY_BEYOND_PX)
-            }
-        });
-        sky(beyond
-            .filter(|y| (y0..y1).contains(y))
-            .and_then(|y| at(x, y)));
-    }
+    // Beyond the disc's edge is deep space: the pixels past each edge point average no
+    // warmer than `sky_max_dn` (a saturated target's piece over the Earth has the
+    // Earth beyond it).
+    let sky_rows = (y0..y1).filter_map(|y| {
+        row_edge(y)
+            .and_then(|e| beyond(e, (x0, x1), left))
+            .and_then(|x| at(x, y))
+    });
+    let sky_columns = (x0..x1).filter_map(|x| {
+        column_edge(x)
+            .and_then(|e| beyond(e, (y0, y1), top_side))
+            .and_then(|y| at(x, y))
+    });
+    let (sky_sum, sky_n) = sky_rows
+        .chain(sky_columns)
+        .fold((0u64, 0u64), |(s, n), v| (s + u64::from(v), n + 1));
     if sky_sum
         .checked_div(sky_n)
         .is_none_or(|m| m > u64::from(sky_max_dn))
@@ -353,6 +319,23 @@ pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
     // The disc's bright region is convex: its edge bulges away from the corner.
     let away = |towards_high: bool| if towards_high { 1.0 } else { -1.0 };
     disc_edge(rows_fit, away(left)) || disc_edge(columns_fit, away(top_side))
+}
+
+/// The edge of the bright level along one line of a box (`span`, px): scanning from
+/// the box's far side towards the frame's side the box touches (the low end when
+/// `from_low`), the first pixel `bright` says is bright; `None` without one or when
+/// the line is bright to the far side (the bright level goes on beyond the box).
+fn edge(
+    span: core::ops::Range<usize>,
+    from_low: bool,
+    bright: impl Fn(usize) -> bool,
+) -> Option<usize> {
+    let (lo, hi) = (span.start, span.end);
+    if from_low {
+        span.rev().find(|&i| bright(i)).filter(|&i| i + 1 < hi)
+    } else {
+        span.into_iter().find(|&i| bright(i)).filter(|&i| i > lo)
+    }
 }
 
 /// How far past the disc's edge [`is_saturated_disc`] reads the sky, px: beyond the
