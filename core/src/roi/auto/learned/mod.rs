@@ -1621,8 +1621,9 @@ impl AutoV2 {
             work.candidate = d.roi.map(|r| (r, score_permille));
             return NO_TARGET;
         }
-        // Stage 4d (session 45): a box that is the Earth's limb at the frame's border is
-        // no target (stage 5e's spots may still answer). A candidate under the gate stays
+        // Stage 4d (session 45): a box that is the Earth's limb at the frame's border, or
+        // (session 54) its disc saturated in a corner, is no target (stage 5e's spots
+        // may still answer). A candidate under the gate stays
         // one: a target entering the frame shows one straight edge too, and the sequence
         // tracker confirms a candidate by its motion against the ground.
         if d.roi.is_some_and(|r| earth_at_border(frame, r, &lv)) {
@@ -2873,7 +2874,7 @@ mod tests {
             }
             px
         };
-        // Its edge runs from (0, 150) to (150, 0).
+        // Its edge runs from (0, 174) to (174, 0).
         let px = with(&|x, y| (x + 400.0).hypot(y + 400.0) < 700.0);
         let frame = Frame::reference(&px).unwrap();
         let d = det.detect(&frame, &mut scratch).unwrap();
