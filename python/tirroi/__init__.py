@@ -328,7 +328,7 @@ class Tracker:
     window around that box, and the box's own cells refined while its place looks the
     same); without one it searches the frame, and also answers a candidate under the
     confidence gate once that candidate followed itself over 3 frames while moving at
-    least 2 px per frame against the ground (score 0.958): a faint target acquired by
+    least 2 px per frame against the ground (score 0.667): a faint target acquired by
     its motion, where clouds and hot pixels move with the ground.
 
     Example::

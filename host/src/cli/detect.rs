@@ -71,7 +71,7 @@ pub struct DetectArgs {
     /// (its level against the background on each side) to take its fast path (the last
     /// box's cells refined without the classifier, kept when the new box looks the
     /// same), and without a box it acquires a target rated under the gate once that
-    /// moved against the ground over 3 frames (score 0.958).
+    /// moved against the ground over 3 frames (score 0.667).
     #[arg(long)]
     pub track: bool,
     /// Frames to process (PNG, TIFF or FITS).
