@@ -173,11 +173,17 @@ impl Confirmation {
         match (self.last, shift) {
             (Some(last), Some(shift)) if follows_prior(&last, &now) => {
                 let (gx, gy) = shift.map_or((0, 0), |s| (i32::from(s.dx_px), i32::from(s.dy_px)));
+                // Saturating: a run may go on for any number of frames.
                 let moved = |a: u16, b: u16, g: i32| i32::from(b) - i32::from(a) - g;
-                self.net_px[0] += moved(last.x0, now.x0, gx);
-                self.net_px[1] += moved(last.y0, now.y0, gy);
-                self.net_px[2] += moved(last.x1, now.x1, gx);
-                self.net_px[3] += moved(last.y1, now.y1, gy);
+                let sides = [
+                    moved(last.x0, now.x0, gx),
+                    moved(last.y0, now.y0, gy),
+                    moved(last.x1, now.x1, gx),
+                    moved(last.y1, now.y1, gy),
+                ];
+                for (net, side) in self.net_px.iter_mut().zip(sides) {
+                    *net = net.saturating_add(side);
+                }
                 self.frames = self.frames.saturating_add(1);
             }
             _ => self.restart(now),
@@ -191,7 +197,7 @@ impl Confirmation {
         // shrinks, a cloud cut by a fixed shading, did not move).
         let both = |a: i32, b: i32| {
             if (a > 0 && b > 0) || (a < 0 && b < 0) {
-                i64::from(a.abs().min(b.abs()))
+                i64::from(a.unsigned_abs().min(b.unsigned_abs()))
             } else {
                 0
             }
