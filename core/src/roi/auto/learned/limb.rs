@@ -39,8 +39,8 @@ const SATURATED_SHARE_DIVISOR: u32 = 10;
 
 /// Largest saturated box [`is_saturated_disc`] tests, as a share of the frame (1/2): the
 /// Earth's disc saturated and cut by a corner (famAE, session 54: the saturated blob's
-/// boxes 20 % and 28 % of the frame); its cost, three reads of each pixel of the box,
-/// stays under half a frame.
+/// boxes 20 % and 28 % of the frame); its cost, at most 8 reads of each pixel of the
+/// box, stays under 4 frames' worth.
 const SATURATED_CORNER_SHARE_DIVISOR: usize = 2;
 
 /// How far, px, the region must go on behind a boundary pixel and the other level
@@ -249,8 +249,11 @@ fn otsu_dn<'a, I: Iterator<Item = &'a [u16]>>(
 /// [`MAX_ARC_RMS2_PX2`] bar isolated specks, bulging away from the corner, sagging at
 /// least [`DISC_MIN_SAG_PX`] and bending no more than the limb can). A saturated
 /// target in the corner shows corners, a straight edge or a tight round face; over
-/// the Earth, the Earth lies beyond it. Four passes over the box (range, histogram,
-/// the sky beyond, the fits); 1 KiB of stack (the histogram).
+/// the Earth, the Earth lies beyond it. Cost, on a box in a corner only: two passes over
+/// the box (range, histogram), then each row's and column's edge scan three times (the
+/// sky beyond, the first fit, the refit without strays; a scan stops at the first bright
+/// pixel from the far side): at most 8 reads per pixel of the box; 1 KiB of stack (the
+/// histogram). Stage 4d calls [`is_limb`] first, whose range pass this repeats.
 pub fn is_saturated_disc(frame: &Frame<'_>, roi: Roi, sky_max_dn: u32) -> bool {
     let (w, h) = (frame.width(), frame.height());
     let Some((x0, y0, x1, y1)) = measurable(frame, roi) else {
