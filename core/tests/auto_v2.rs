@@ -30,7 +30,9 @@ use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{
     AutoV2, AutoV2Scratch, AutoV2Work, BORDER_PIECE_SCORE_PERMILLE, BlobRule,
-    DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, rated_spots,
+    DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, frame_segments,
+    polygon, rated_spots,
+    segments::{self, Segment},
 };
 use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
@@ -65,14 +67,15 @@ fn params() -> impl Strategy<Value = AutoV2> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
-        // (spot, link_cells, look, candidate floor, spots compete below): proptest's
-        // tuples end at 12.
+        // (spot, link_cells, look, candidate floor, spots compete below, outline):
+        // proptest's tuples end at 12.
         (
             any::<bool>(),
             prop_oneof![Just(2u8), 1u8..=3],
             look(),
             prop_oneof![Just(None), (0u16..=1000).prop_map(Some)],
             prop_oneof![Just(800u16), 0u16..=1000],
+            any::<bool>(),
         ),
     )
         .prop_map(
@@ -88,7 +91,14 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 deep_space,
                 small_target,
                 candidates,
-                (spot, link_cells, look, candidate_floor_permille, spot_competes_below_permille),
+                (
+                    spot,
+                    link_cells,
+                    look,
+                    candidate_floor_permille,
+                    spot_competes_below_permille,
+                    outline,
+                ),
             )| {
                 AutoV2 {
                     prior,
@@ -105,6 +115,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     candidates,
                     spot,
                     spot_competes_below_permille,
+                    outline,
                     link_cells,
                     candidate_floor_permille,
                 }
@@ -249,6 +260,14 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 prop_assert!(det.prior.is_some() && det.look.is_some(), "{d:?}");
                 prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
                 TRACKED_SCORE_PERMILLE
+            } else if let Some(o) = work.outline() {
+                // Stage 5f's box: the other stages' answer was none or rated lower, on
+                // a whole-frame search; no other stage's telemetry.
+                prop_assert!(det.outline, "{d:?}");
+                prop_assert_eq!(Some(o.roi), d.roi);
+                prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
+                prop_assert!(!work.blob_won() && work.deep_space().is_none(), "{d:?}");
+                polygon::OUTLINE_SCORE_PERMILLE
             } else if let Some((roi, score)) = work.spot() {
                 // Stage 5e's box: the other stages answered no target, or their box was
                 // rated below `spot_competes_below_permille` and lower than the spot.
@@ -602,6 +621,7 @@ fn spots_replace_a_weaker_answer_and_only_that() {
         let alone = AutoV2 {
             spot_competes_below_permille: 0,
             min_score_permille: 0,
+            outline: false,
             ..AutoV2::default()
         };
         let competing = AutoV2 {
@@ -629,6 +649,69 @@ fn spots_replace_a_weaker_answer_and_only_that() {
             _ => {
                 assert_eq!(after, before, "seed {seed}");
                 kept += usize::from(before.roi.is_some());
+            }
+        }
+    }
+    assert!(replaced > 0 && kept > 0, "replaced {replaced}, kept {kept}");
+}
+
+/// Stage 5f, the straight outline (`AutoV2::outline`), against its rule built from
+/// parts: the answer without it (`outline: false`), and the frame's outline from
+/// `learned::frame_segments` and `polygon::strongest` (the stage's own parts, called
+/// on their own). On a whole-frame search the outline's box and
+/// `OUTLINE_SCORE_PERMILLE` are the answer exactly when there is an outline and the
+/// other stages' answer is "no target" or rated below that; else their answer stands.
+/// A dark quadrilateral drawn on half the frames gives both branches.
+#[test]
+fn an_outline_replaces_a_weaker_answer_and_only_that() {
+    let mut scratch = Box::new(AutoV2Scratch::new());
+    let mut part_work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
+    let (mut replaced, mut kept) = (0, 0);
+    for seed in 0..120u64 {
+        let (w, h) = (
+            120 + (seed as usize % 4) * 40,
+            96 + (seed as usize % 3) * 32,
+        );
+        let mut img = frame(seed, w, h, 14);
+        if seed % 2 == 0 {
+            // A dark parallelogram (sides 40 and 26 px, slanted 1 px in 4) at a tenth of
+            // the range: straight edges meeting at corners.
+            let (ox, oy) = (
+                10 + (seed as usize * 7) % (w - 70),
+                10 + (seed as usize * 5) % (h - 40),
+            );
+            for y in 0..26 {
+                for x in 0..40 {
+                    let v = img.at(ox + x + y / 4, oy + y);
+                    *v = 1600;
+                }
+            }
+        }
+        let f = img.frame();
+        let without = AutoV2 {
+            outline: false,
+            ..AutoV2::default()
+        };
+        let before = without.detect(&f, &mut scratch).unwrap();
+        let after = AutoV2::default().detect(&f, &mut scratch).unwrap();
+        let mut segs = [Segment::default(); segments::MAX_SEGMENTS];
+        let n = frame_segments(&f, &mut part_work, &mut segs);
+        let outline = polygon::strongest(&segs[..n], w, h);
+        let weak = before.roi.is_none() || before.score_permille < polygon::OUTLINE_SCORE_PERMILLE;
+        match outline {
+            Some(o) if weak => {
+                assert_eq!(
+                    (after.roi, after.score_permille),
+                    (Some(o.roi), polygon::OUTLINE_SCORE_PERMILLE),
+                    "seed {seed}"
+                );
+                assert_eq!(scratch.work().outline(), Some(o), "seed {seed}");
+                replaced += 1;
+            }
+            _ => {
+                assert_eq!(after, before, "seed {seed}");
+                assert_eq!(scratch.work().outline(), None, "seed {seed}");
+                kept += 1;
             }
         }
     }

@@ -43,7 +43,7 @@ pub enum SharedScratch {
     Dog(DogScratch),
     /// [`Auto`]'s scratch.
     Auto(AutoScratch),
-    /// [`AutoV2`]'s scratch (48 768 B on x86-64: below DoG's, so the area, and the
+    /// [`AutoV2`]'s scratch (48 792 B on x86-64: below DoG's, so the area, and the
     /// demo's RAM, keep DoG's size).
     AutoV2(AutoV2Scratch),
 }

@@ -103,6 +103,7 @@ fuzz_target!(|data: &[u8]| {
         } else {
             (u16::from(data[7]) * 4).min(1000)
         },
+        outline: data[3] & 0x04 == 0,
         // 1..=3 (the width's byte's top bits: every value is also a width).
         link_cells: 1 + (data[0] >> 6) % 3,
         candidate_floor_permille: None,

@@ -30,6 +30,11 @@
 //! solidity ‰, ring depth ‰, others ‰, sides, its confidence ‰; empty without one),
 //! the blob model's training data (`scripts/train-auto.py --blob`).
 //!
+//! `... -- segments DIR OUT.csv` writes the straight edges of every frame
+//! (`learned::frame_segments`): `file,k,x0_q,y0_q,x1_q,y1_q,dir_x,dir_y,length_q,blocks`
+//! (ends in quarter pixels, the mean gradient direction × 1024, length in quarter
+//! pixels, the region's 2×2 blocks).
+//!
 //! `... -- spots DIR OUT.csv` writes stage 5e's rated spots of every frame (whatever
 //! the other stages answer; `learned::rated_spots`): one line per spot,
 //! `file,k,x,y,x0,y0,x1,y1,score,f0..f16` (the spot's centre, its region's box, the
@@ -44,7 +49,9 @@ use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, rated_spots,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, frame_segments,
+    rated_spots,
+    segments::{self, Segment},
 };
 use tirroi_host::imaging::image_io::read_frame;
 
@@ -117,7 +124,18 @@ fn main() {
             let f = read_frame(&dir.join(file), Some(*bits)).expect("frame");
             let frame = f.view().expect("view");
             let mut s = String::new();
-            if mode == "spots" {
+            if mode == "segments" {
+                let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
+                let mut segs = [Segment::default(); segments::MAX_SEGMENTS];
+                let n = frame_segments(&frame, &mut work, &mut segs);
+                for (k, g) in segs[..n].iter().enumerate() {
+                    let _ = writeln!(
+                        s,
+                        "{file},{k},{},{},{},{},{},{},{},{}",
+                        g.x0_q, g.y0_q, g.x1_q, g.y1_q, g.dir_x, g.dir_y, g.length_q, g.blocks
+                    );
+                }
+            } else if mode == "spots" {
                 let mut work: Box<AutoV2Work> = Box::new(ConstInit::INIT);
                 for (k, r) in rated_spots(&frame, &mut work).iter().enumerate() {
                     let Some(r) = r else { break };
@@ -189,6 +207,8 @@ fn main() {
                     } else {
                         AutoV2::default().spot_competes_below_permille
                     },
+                    // `predict-all`: nor does stage 5f's outline.
+                    outline: mode != "predict-all",
                     ..AutoV2::default()
                 };
                 let mut d = gate_off.detect(&frame, &mut scratch).expect("detect");
@@ -275,7 +295,9 @@ fn main() {
             s
         })
         .collect();
-    let header = if mode == "spots" {
+    let header = if mode == "segments" {
+        "file,k,x0_q,y0_q,x1_q,y1_q,dir_x,dir_y,length_q,blocks".to_string()
+    } else if mode == "spots" {
         let mut h = "file,k,x,y,x0,y0,x1,y1,score".to_string();
         for k in 0..tirroi_core::roi::auto::learned::spot::SPOT_FEATURES {
             let _ = write!(h, ",f{k}");

@@ -36,8 +36,10 @@ pub mod limb;
 pub mod look;
 pub mod narrow;
 pub mod order;
+pub mod polygon;
 pub mod prescreen;
 pub mod saturated;
+pub mod segments;
 pub mod shape;
 pub mod small;
 pub mod smooth;
@@ -168,6 +170,14 @@ pub struct AutoV2 {
     /// which no family A set loses. No false alarm added on any set (`docs/detectors.md`
     /// § Session 46).
     pub spot_competes_below_permille: u16,
+    /// Stage 5f ([`polygon`], session 55): on a whole-frame search whose answer is
+    /// rated below [`polygon::OUTLINE_SCORE_PERMILLE`] (or is "no target"), the frame's
+    /// straight outline — long straight edges meeting at agreeing corners — is the
+    /// answer when it has one, with that confidence. Default on: on family A (seeds
+    /// 7001, 7101, 7201) radiometry close 0.357 → 0.53, the Tango close row 0.383 →
+    /// 0.47, no false alarm added on famAE (`docs/detectors.md` § Session 55). It
+    /// costs one pass of the segment detector ([`segments`]) on those frames.
+    pub outline: bool,
     /// Stage 4c: after the confidence rated the winner, target cells of other
     /// components up to this many cells from the winner's (Chebyshev) join it where
     /// the cell midway is at the body's level ([`bridges_body`]), cells: 1 joins
@@ -542,6 +552,7 @@ impl AutoV2 {
         candidates: 3,
         spot: true,
         spot_competes_below_permille: 800,
+        outline: true,
         link_cells: 2,
         candidate_floor_permille: None,
     };
@@ -702,6 +713,7 @@ pub struct AutoV2Work<C: FrameCapacity = Reference> {
     tracked: bool,
     deep_space: Option<smooth::DeepSpace>,
     spot: Option<(Roi, u16)>,
+    outline: Option<polygon::Outline>,
     candidate: Option<(Roi, u16)>,
 }
 
@@ -722,6 +734,16 @@ impl<C: FrameCapacity> AutoV2Work<C> {
             self.sum_sq.as_mut(),
             self.sum_q.as_mut(),
         )
+    }
+
+    /// The frame's straight edges ([`segments::detect`]): the integral planes, free
+    /// once the other stages have run, lend the marks (one bit per pixel).
+    fn segments(&mut self, frame: &Frame<'_>, sigma: u32, out: &mut [segments::Segment]) -> usize {
+        let pixels = frame.width() * frame.height();
+        match segments::Marks::new(self.sum.as_mut(), self.sum_sq.as_mut(), pixels) {
+            Some(mut marks) => segments::detect(frame, sigma, &mut marks, out),
+            None => 0,
+        }
     }
 
     /// What the region stage chose on the last frame (`None` when stage 4d found its
@@ -760,6 +782,7 @@ impl<C: FrameCapacity> AutoV2Work<C> {
         self.blob_won = false;
         self.deep_space = None;
         self.spot = None;
+        self.outline = None;
         d
     }
 
@@ -778,6 +801,13 @@ impl<C: FrameCapacity> AutoV2Work<C> {
     /// [`AutoV2::spot_competes_below_permille`]) or the stage is off.
     pub fn spot(&self) -> Option<(Roi, u16)> {
         self.spot
+    }
+
+    /// Stage 5f's outline when it was the last frame's answer ([`polygon`]: it
+    /// competes with an answer under its confidence, or none, on a whole-frame search);
+    /// `None` otherwise.
+    pub fn outline(&self) -> Option<polygon::Outline> {
+        self.outline
     }
 
     /// The last frame's candidate below the gate ([`AutoV2::candidate_floor_permille`]):
@@ -813,6 +843,7 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         tracked: false,
         deep_space: None,
         spot: None,
+        outline: None,
         candidate: None,
     };
 }
@@ -852,6 +883,31 @@ pub fn rated_spots<C: FrameCapacity>(
     let win = Window::full(frame);
     let (_, lv) = prepare_cells(frame, work, win);
     work.rate_spots(frame, win, &lv)
+}
+
+/// The straight edges of the whole `frame` ([`segments::detect`] with the frame's
+/// noise σ; the integral planes lend the marks) into `out`; returns how many.
+pub fn frame_segments<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    out: &mut [segments::Segment],
+) -> usize {
+    let win = Window::full(frame);
+    let (_, lv) = prepare_cells(frame, work, win);
+    work.segments(frame, lv.sigma, out)
+}
+
+/// Stage 5f ([`polygon`]): the frame's straight outline, from its segments (on the
+/// stack, [`segments::MAX_SEGMENTS`] of 16 B) found with the integral planes' marks.
+#[inline(never)]
+fn outline_stage<C: FrameCapacity>(
+    frame: &Frame<'_>,
+    work: &mut AutoV2Work<C>,
+    sigma: u32,
+) -> Option<polygon::Outline> {
+    let mut segs = [segments::Segment::default(); segments::MAX_SEGMENTS];
+    let n = work.segments(frame, sigma, &mut segs);
+    polygon::strongest(segs.get(..n)?, frame.width(), frame.height())
 }
 
 /// Stages 1–3: prepares the planes ([`prepare`]), computes the features of the 8×8
@@ -1437,7 +1493,45 @@ impl AutoV2 {
         let (plane8, lv) = prepare_cells(frame, work, win);
         work.tracked = false;
         work.spot = None;
+        work.outline = None;
         work.candidate = None;
+        let d = self.regions_and_spots(frame, work, win, plane8, lv);
+        // Stage 5f: a straight outline competes with a weak answer or none, on a
+        // whole-frame search (in a tracking window the prior says where the target is).
+        if !self.outline
+            || !win.is_full(frame)
+            || d.roi.is_some() && d.score_permille >= polygon::OUTLINE_SCORE_PERMILLE
+            || polygon::OUTLINE_SCORE_PERMILLE < self.min_score_permille
+        {
+            return d;
+        }
+        let Some(outline) = outline_stage(frame, work, lv.sigma) else {
+            return d;
+        };
+        // The outline is the answer: no other stage's (telemetry reads these).
+        work.outline = Some(outline);
+        work.candidate = None;
+        work.winner = None;
+        work.blob_won = false;
+        work.deep_space = None;
+        work.spot = None;
+        Detection {
+            roi: Some(outline.roi),
+            threshold: 0,
+            foreground_px: u32::from(outline.roi.width()) * u32::from(outline.roi.height()),
+            score_permille: polygon::OUTLINE_SCORE_PERMILLE,
+        }
+    }
+
+    /// Stages 2b–8 and 5e on the window's planes: every stage but 5f.
+    fn regions_and_spots<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+    ) -> Detection {
         let d = self.region_stages(frame, work, win, plane8, lv);
         let d = if d
             .roi
@@ -3340,6 +3434,7 @@ mod tests {
             blob,
             saturated_erode_px: 0,
             spot_competes_below_permille: 0,
+            outline: false,
             ..AutoV2::default()
         };
         let mut outcomes = [0usize; 2];

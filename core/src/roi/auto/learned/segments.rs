@@ -1,0 +1,409 @@
+//! The frame's straight edges (line segments), the cue an eye reads a spacecraft by
+//! over the Earth: its outline and face boundaries are long straight steps that meet
+//! at corners, where cloud edges are ragged and short and the limb is one smooth arc.
+//!
+//! A region-growing line-segment detector after Grompone von Gioi et al.'s LSD (IPOL
+//! 2012), in integers and `f32`, bounded memory and no allocation:
+//! 1. the gradient of every 2×2 block (`gx = (b + d) − (a + c)`, `gy = (c + d) − (a +
+//!    b)`: each component's noise is 2 σ) is an *edge* when its magnitude reaches
+//!    [`EDGE_SIGMAS`] of that noise, a *seed* from [`SEED_SIGMAS`];
+//! 2. from each seed not yet in a region (raster order), the region grows over the
+//!    8-connected edge blocks whose gradient direction lies within
+//!    [`ANGLE_TOLERANCE_DEG`] of the region's mean direction (updated with each block,
+//!    so a slowly bending arc is followed only while it stays straight);
+//! 3. a region is a segment when its blocks' spread along the direction across its
+//!    gradient, read as a uniform distribution, spans at least [`MIN_LENGTH_PX`] and
+//!    [`MIN_ELONGATION`] times its spread across (the edge's width: the optics blur a
+//!    step over 2–3 px).
+//!
+//! The segment keeps its mean gradient direction (towards the brighter side), so a
+//! group of segments knows on which side of each edge its darker region lies.
+//!
+//! Memory: one bit per pixel, lent by the caller ([`Marks`], 10 168 B at 328×248 in two
+//! slices of `auto-v2`'s integral planes, free at this stage); on the stack a frontier
+//! of [`FRONTIER_BLOCKS`] block indices (1 KiB) and the [`MAX_SEGMENTS`] segments
+//! (16 B each, 1 536 B).
+//! Cost: per pixel one 2×2 gradient (4 reads) against the seed threshold; per block
+//! added to a region a square root and its 8 neighbours' gradients.
+
+use crate::frame::Frame;
+
+/// Segments kept per frame: the longest when more are found. A spacecraft's outline
+/// and face boundaries give 3–12 segments of ≥ 10 px (famA's radiometry-close frames,
+/// session 55, OpenCV's LSD); a textured Earth 10–70 more.
+pub const MAX_SEGMENTS: usize = 96;
+
+/// A 2×2 block is an edge when its gradient magnitude reaches this many noise σ of a
+/// component (each is a difference of two sums of two pixels, σ·2): 4 such σ leave a
+/// noise block in about e⁻⁸ ≈ 3·10⁻⁴ (the magnitude of two Gaussian components is
+/// Rayleigh).
+pub const EDGE_SIGMAS: u32 = 4;
+
+/// A block seeds a region from this many noise σ of a component: twice the edge
+/// threshold, so regions start on real steps and grow into their weaker ends.
+pub const SEED_SIGMAS: u32 = 8;
+
+/// Largest angle between a block's gradient and its region's mean direction, degrees:
+/// LSD's τ = 22.5° (π/8): two blocks of a straight step agree within it under noise
+/// at the edge threshold, a corner of a polygon (≥ 30°) breaks the region.
+pub const ANGLE_TOLERANCE_DEG: f32 = 22.5;
+
+/// Shortest segment, pixels: a spacecraft's face edge at close range spans tens of
+/// pixels; cloud edges reach 10 px straight now and then (the grouping decides).
+pub const MIN_LENGTH_PX: f32 = 10.0;
+
+/// Least ratio of a segment's length to its width (both from the spread of its blocks):
+/// a blurred straight step is 2–3 px wide, so a 10-px segment is 3–5 times longer than
+/// wide; a blob of texture is not.
+pub const MIN_ELONGATION: f32 = 3.0;
+
+/// Blocks waiting to be grown from at once (a region whose frontier is longer stops
+/// widening there: a straight edge's frontier is a few blocks).
+pub const FRONTIER_BLOCKS: usize = 256;
+
+/// A region stops growing at this many blocks (a 300-px edge 3 px wide is 900; the
+/// sums stay exact in `i64` and the cost bounded).
+pub const MAX_REGION_BLOCKS: u32 = 4096;
+
+/// Fewest blocks of a region read as a segment (a 10-px edge 1 px wide).
+const MIN_REGION_BLOCKS: u32 = 10;
+
+/// `cos(ANGLE_TOLERANCE_DEG)`.
+const COS_TOLERANCE: f32 = 0.923_879_5;
+
+/// Fixed-point scale of a segment's unit gradient direction.
+pub const DIRECTION_ONE: i32 = 1024;
+
+/// One straight edge of the frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Segment {
+    /// First end, quarter pixels (pixel (x, y)'s centre at (4x, 4y)).
+    pub x0_q: i16,
+    /// First end, quarter pixels.
+    pub y0_q: i16,
+    /// Second end, quarter pixels.
+    pub x1_q: i16,
+    /// Second end, quarter pixels.
+    pub y1_q: i16,
+    /// Mean gradient direction (dark → bright), x, unit vector × [`DIRECTION_ONE`].
+    pub dir_x: i16,
+    /// Mean gradient direction, y, unit vector × [`DIRECTION_ONE`].
+    pub dir_y: i16,
+    /// Length, quarter pixels.
+    pub length_q: u16,
+    /// 2×2 blocks of its region (≤ [`MAX_REGION_BLOCKS`]).
+    pub blocks: u16,
+}
+
+/// One bit per pixel (a block's "in a region" mark), in two slices lent by the caller.
+pub struct Marks<'a> {
+    lo: &'a mut [u32],
+    hi: &'a mut [u32],
+}
+
+impl<'a> Marks<'a> {
+    /// Marks over `lo` then `hi` for `pixels` pixels, cleared; `None` when the two hold
+    /// fewer than `pixels` bits.
+    pub fn new(lo: &'a mut [u32], hi: &'a mut [u32], pixels: usize) -> Option<Self> {
+        if (lo.len() + hi.len()) * 32 < pixels {
+            return None;
+        }
+        lo.fill(0);
+        hi.fill(0);
+        Some(Marks { lo, hi })
+    }
+
+    fn word(&mut self, i: usize) -> Option<&mut u32> {
+        let w = i / 32;
+        let n = self.lo.len();
+        if w < n {
+            self.lo.get_mut(w)
+        } else {
+            self.hi.get_mut(w - n)
+        }
+    }
+
+    fn get(&mut self, i: usize) -> bool {
+        self.word(i).is_some_and(|w| *w & (1 << (i % 32)) != 0)
+    }
+
+    fn set(&mut self, i: usize) {
+        if let Some(w) = self.word(i) {
+            *w |= 1 << (i % 32);
+        }
+    }
+}
+
+/// The gradient of the 2×2 block at (x, y)..(x + 1, y + 1), `i = y·width + x`, DN
+/// clamped to `top`: `(b + d − a − c, c + d − a − b)`.
+#[inline(always)]
+fn gradient(px: &[u16], width: usize, i: usize, top: u16) -> (i32, i32) {
+    let at = |k: usize| i32::from(px.get(k).copied().unwrap_or(0).min(top));
+    let (a, b) = (at(i), at(i + 1));
+    let (c, d) = (at(i + width), at(i + width + 1));
+    (b + d - a - c, c + d - a - b)
+}
+
+/// The running sums of a growing region.
+struct Region {
+    /// Σ unit gradient directions.
+    sx: f32,
+    sy: f32,
+    /// Blocks, and Σ of their offsets from the seed and of the offsets' products.
+    n: u32,
+    dx: i64,
+    dy: i64,
+    dxx: i64,
+    dxy: i64,
+    dyy: i64,
+}
+
+impl Region {
+    fn add(&mut self, ux: f32, uy: f32, ox: i64, oy: i64) {
+        self.sx += ux;
+        self.sy += uy;
+        self.n += 1;
+        self.dx += ox;
+        self.dy += oy;
+        self.dxx += ox * ox;
+        self.dxy += ox * oy;
+        self.dyy += oy * oy;
+    }
+
+    /// Whether unit direction (ux, uy) lies within the tolerance of the mean direction.
+    fn agrees(&self, ux: f32, uy: f32) -> bool {
+        let dot = ux * self.sx + uy * self.sy;
+        let norm2 = self.sx * self.sx + self.sy * self.sy;
+        dot > 0.0 && dot * dot >= COS_TOLERANCE * COS_TOLERANCE * norm2
+    }
+
+    /// The region as a segment (seed block at (x, y)), or `None` when it is too short,
+    /// too wide or too small.
+    fn segment(&self, x: usize, y: usize) -> Option<Segment> {
+        if self.n < MIN_REGION_BLOCKS {
+            return None;
+        }
+        let n = self.n as f32;
+        let norm = libm::sqrtf(self.sx * self.sx + self.sy * self.sy);
+        if norm <= 0.0 {
+            return None;
+        }
+        let (gx, gy) = (self.sx / norm, self.sy / norm);
+        // The line runs across the gradient.
+        let (lx, ly) = (-gy, gx);
+        // Central second moments, exact in i64 (n · Σx² − (Σx)²) then scaled.
+        let nn = i64::from(self.n);
+        let cxx = (nn * self.dxx - self.dx * self.dx) as f32 / (n * n);
+        let cxy = (nn * self.dxy - self.dx * self.dy) as f32 / (n * n);
+        let cyy = (nn * self.dyy - self.dy * self.dy) as f32 / (n * n);
+        let along = lx * lx * cxx + 2.0 * lx * ly * cxy + ly * ly * cyy;
+        let across = gx * gx * cxx + 2.0 * gx * gy * cxy + gy * gy * cyy;
+        // A uniform spread over L has variance L²/12.
+        let length = libm::sqrtf(12.0 * along.max(0.0));
+        let width = libm::sqrtf(12.0 * across.max(0.0)).max(1.0);
+        if length < MIN_LENGTH_PX || length < MIN_ELONGATION * width {
+            return None;
+        }
+        // Centre: the seed plus the mean offset, plus half a pixel (the block's centre).
+        let cx = x as f32 + self.dx as f32 / n + 0.5;
+        let cy = y as f32 + self.dy as f32 / n + 0.5;
+        let h = length / 2.0;
+        let q = |v: f32| (v * 4.0) as i16;
+        Some(Segment {
+            x0_q: q(cx - lx * h),
+            y0_q: q(cy - ly * h),
+            x1_q: q(cx + lx * h),
+            y1_q: q(cy + ly * h),
+            dir_x: (gx * DIRECTION_ONE as f32) as i16,
+            dir_y: (gy * DIRECTION_ONE as f32) as i16,
+            length_q: (length * 4.0).min(f32::from(u16::MAX)) as u16,
+            blocks: self.n.min(u32::from(u16::MAX)) as u16,
+        })
+    }
+}
+
+/// The straight edges of `frame` (noise σ `sigma` DN) into `out`, the longest kept when
+/// there are more; returns how many (≤ `out.len()`). `marks` holds one bit per pixel
+/// (cleared by [`Marks::new`]).
+pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [Segment]) -> usize {
+    let (w, h) = (frame.width(), frame.height());
+    if w < 2 || h < 2 || out.is_empty() {
+        return 0;
+    }
+    let px = frame.pixels();
+    let top = frame.max_dn();
+    // Component noise 2σ; thresholds on the squared magnitude.
+    let unit = 2 * i64::from(sigma.max(1));
+    let edge2 = (i64::from(EDGE_SIGMAS) * unit).pow(2);
+    let seed2 = (i64::from(SEED_SIGMAS) * unit).pow(2);
+    let mut found = 0usize;
+    let mut frontier = [0u32; FRONTIER_BLOCKS];
+    for y in 0..h - 1 {
+        for x in 0..w - 1 {
+            let i = y * w + x;
+            let (gx, gy) = gradient(px, w, i, top);
+            let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
+            if m2 < seed2 || marks.get(i) {
+                continue;
+            }
+            let m = libm::sqrtf(m2 as f32);
+            let mut region = Region {
+                sx: 0.0,
+                sy: 0.0,
+                n: 0,
+                dx: 0,
+                dy: 0,
+                dxx: 0,
+                dxy: 0,
+                dyy: 0,
+            };
+            region.add(gx as f32 / m, gy as f32 / m, 0, 0);
+            marks.set(i);
+            frontier[0] = i as u32;
+            let mut len = 1usize;
+            while len > 0 && region.n < MAX_REGION_BLOCKS {
+                len -= 1;
+                let p = frontier.get(len).copied().unwrap_or(0) as usize;
+                let (px_, py_) = (p % w, p / w);
+                for (ox, oy) in NEIGHBOURS {
+                    let (qx, qy) = (px_ as isize + ox, py_ as isize + oy);
+                    if qx < 0 || qy < 0 || qx as usize >= w - 1 || qy as usize >= h - 1 {
+                        continue;
+                    }
+                    let q = qy as usize * w + qx as usize;
+                    if marks.get(q) {
+                        continue;
+                    }
+                    let (gx, gy) = gradient(px, w, q, top);
+                    let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
+                    if m2 < edge2 {
+                        continue;
+                    }
+                    let m = libm::sqrtf(m2 as f32);
+                    let (ux, uy) = (gx as f32 / m, gy as f32 / m);
+                    if !region.agrees(ux, uy) {
+                        continue;
+                    }
+                    marks.set(q);
+                    region.add(ux, uy, qx as i64 - x as i64, qy as i64 - y as i64);
+                    if let Some(slot) = frontier.get_mut(len) {
+                        *slot = q as u32;
+                        len += 1;
+                    }
+                }
+            }
+            let Some(s) = region.segment(x, y) else {
+                continue;
+            };
+            if found < out.len() {
+                if let Some(slot) = out.get_mut(found) {
+                    *slot = s;
+                }
+                found += 1;
+            } else if let Some(shortest) = out.iter_mut().min_by_key(|t| t.length_q) {
+                if shortest.length_q < s.length_q {
+                    *shortest = s;
+                }
+            }
+        }
+    }
+    found
+}
+
+/// The 8 neighbours' offsets.
+const NEIGHBOURS: [(isize, isize); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+    use std::vec;
+
+    const W: usize = 120;
+    const H: usize = 90;
+
+    fn run(px: &[u16], sigma: u32) -> std::vec::Vec<Segment> {
+        let frame = Frame::new(px, W, H, 14).unwrap();
+        let (mut lo, mut hi) = (vec![0u32; 200], vec![0u32; 200]);
+        let mut marks = Marks::new(&mut lo, &mut hi, W * H).unwrap();
+        let mut out = [Segment::default(); MAX_SEGMENTS];
+        let n = detect(&frame, sigma, &mut marks, &mut out);
+        out[..n].to_vec()
+    }
+
+    #[test]
+    fn a_dark_rectangle_gives_its_four_sides() {
+        // A 60 × 40 px rectangle at 1 000 DN on 3 000 DN, corners (30, 25)–(89, 64).
+        let px: std::vec::Vec<u16> = (0..W * H)
+            .map(|i| {
+                let (x, y) = (i % W, i / W);
+                if (30..90).contains(&x) && (25..65).contains(&y) {
+                    1000
+                } else {
+                    3000
+                }
+            })
+            .collect();
+        let segs = run(&px, 2);
+        assert_eq!(segs.len(), 4, "{segs:?}");
+        for s in &segs {
+            let (x0, y0, x1, y1) = (
+                s.x0_q as f32 / 4.0,
+                s.y0_q as f32 / 4.0,
+                s.x1_q as f32 / 4.0,
+                s.y1_q as f32 / 4.0,
+            );
+            let horizontal = (y0 - y1).abs() < 1.0;
+            if horizontal {
+                // Top edge between rows 24 and 25 (block centre 24.5), bottom 64.5.
+                let y = (y0 + y1) / 2.0;
+                assert!((y - 24.5).abs() < 0.6 || (y - 64.5).abs() < 0.6, "{s:?}");
+                let len = (x1 - x0).abs();
+                assert!((len - 60.0).abs() < 4.0, "{s:?}");
+                // The gradient points to the brighter side: outwards.
+                assert_eq!(s.dir_y.signum(), if y < 40.0 { -1 } else { 1 }, "{s:?}");
+            } else {
+                assert!((x0 - x1).abs() < 1.0, "{s:?}");
+                let x = (x0 + x1) / 2.0;
+                assert!((x - 29.5).abs() < 0.6 || (x - 89.5).abs() < 0.6, "{s:?}");
+                assert!(((y1 - y0).abs() - 40.0).abs() < 4.0, "{s:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_disc_and_noise_give_no_long_segment() {
+        // A disc of radius 30 px: its edge bends 22.5° every ~12 px, so pieces stay
+        // short; flat noise gives none.
+        let mut state = 12345u32;
+        let px: std::vec::Vec<u16> = (0..W * H)
+            .map(|i| {
+                state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                let noise = (state >> 16) % 7;
+                let (x, y) = (i % W, i / W);
+                let r2 = (x as i32 - 60).pow(2) + (y as i32 - 45).pow(2);
+                (if r2 < 900 { 1000 } else { 3000 }) + noise as u16
+            })
+            .collect();
+        let segs = run(&px, 2);
+        for s in &segs {
+            assert!(s.length_q < 4 * 16, "{s:?}");
+        }
+        let flat: std::vec::Vec<u16> = (0..W * H)
+            .map(|_| {
+                state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                3000 + ((state >> 16) % 7) as u16
+            })
+            .collect();
+        assert!(run(&flat, 2).is_empty());
+    }
+}
