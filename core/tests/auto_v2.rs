@@ -267,7 +267,7 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 prop_assert_eq!(Some(o.roi), d.roi);
                 prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
                 prop_assert!(!work.blob_won() && work.deep_space().is_none(), "{d:?}");
-                polygon::OUTLINE_SCORE_PERMILLE
+                o.score_permille()
             } else if let Some((roi, score)) = work.spot() {
                 // Stage 5e's box: the other stages answered no target, or their box was
                 // rated below `spot_competes_below_permille` and lower than the spot.
@@ -658,9 +658,10 @@ fn spots_replace_a_weaker_answer_and_only_that() {
 /// Stage 5f, the straight outline (`AutoV2::outline`), against its rule built from
 /// parts: the answer without it (`outline: false`), and the frame's outline from
 /// `learned::frame_segments` and `polygon::strongest` (the stage's own parts, called
-/// on their own). On a whole-frame search the outline's box and
-/// `OUTLINE_SCORE_PERMILLE` are the answer exactly when there is an outline and the
-/// other stages' answer is "no target" or rated below that; else their answer stands.
+/// on their own). On a whole-frame search the outline's box and its confidence are the
+/// answer exactly when there is an outline and the other stages' answer is "no target"
+/// or rated below it (the default gate is under both of its ratings); else their
+/// answer stands.
 /// A dark quadrilateral drawn on half the frames gives both branches.
 #[test]
 fn an_outline_replaces_a_weaker_answer_and_only_that() {
@@ -697,12 +698,14 @@ fn an_outline_replaces_a_weaker_answer_and_only_that() {
         let mut segs = [Segment::default(); segments::MAX_SEGMENTS];
         let n = frame_segments(&f, &mut part_work, &mut segs);
         let outline = polygon::strongest(&segs[..n], w, h);
-        let weak = before.roi.is_none() || before.score_permille < polygon::OUTLINE_SCORE_PERMILLE;
+        let weaker = |o: polygon::Outline| {
+            before.roi.is_none() || before.score_permille < o.score_permille()
+        };
         match outline {
-            Some(o) if weak => {
+            Some(o) if weaker(o) => {
                 assert_eq!(
                     (after.roi, after.score_permille),
-                    (Some(o.roi), polygon::OUTLINE_SCORE_PERMILLE),
+                    (Some(o.roi), o.score_permille()),
                     "seed {seed}"
                 );
                 assert_eq!(scratch.work().outline(), Some(o), "seed {seed}");

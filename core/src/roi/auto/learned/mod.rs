@@ -171,9 +171,10 @@ pub struct AutoV2 {
     /// § Session 46).
     pub spot_competes_below_permille: u16,
     /// Stage 5f ([`polygon`], session 55): on a whole-frame search whose answer is
-    /// rated below [`polygon::OUTLINE_SCORE_PERMILLE`] (or is "no target"), the frame's
-    /// straight outline — long straight edges meeting at agreeing corners — is the
-    /// answer when it has one, with that confidence. Default on: on family A (seeds
+    /// "no target" or rated below [`polygon::MAX_SCORE_PERMILLE`], the frame's straight
+    /// outline — long straight edges meeting at agreeing corners — is the answer when
+    /// it has one rated higher ([`polygon::Outline::score_permille`]) and passing the
+    /// gate. Default on: on family A (seeds
     /// 7001, 7101, 7201) radiometry close 0.357 → 0.53, the Tango close row 0.383 →
     /// 0.47, no false alarm added on famAE (`docs/detectors.md` § Session 55). It
     /// costs one pass of the segment detector ([`segments`]) on those frames.
@@ -1500,14 +1501,20 @@ impl AutoV2 {
         // whole-frame search (in a tracking window the prior says where the target is).
         if !self.outline
             || !win.is_full(frame)
-            || d.roi.is_some() && d.score_permille >= polygon::OUTLINE_SCORE_PERMILLE
-            || polygon::OUTLINE_SCORE_PERMILLE < self.min_score_permille
+            || d.roi.is_some() && d.score_permille >= polygon::MAX_SCORE_PERMILLE
+            || polygon::MAX_SCORE_PERMILLE < self.min_score_permille
         {
             return d;
         }
         let Some(outline) = outline_stage(frame, work, lv.sigma) else {
             return d;
         };
+        let score_permille = outline.score_permille();
+        if score_permille < self.min_score_permille
+            || d.roi.is_some() && d.score_permille >= score_permille
+        {
+            return d;
+        }
         // The outline is the answer: no other stage's (telemetry reads these).
         work.outline = Some(outline);
         work.candidate = None;
@@ -1519,7 +1526,7 @@ impl AutoV2 {
             roi: Some(outline.roi),
             threshold: 0,
             foreground_px: u32::from(outline.roi.width()) * u32::from(outline.roi.height()),
-            score_permille: polygon::OUTLINE_SCORE_PERMILLE,
+            score_permille,
         }
     }
 
@@ -2992,7 +2999,12 @@ mod tests {
     /// warmer than the sky is the stage's.
     #[test]
     fn a_face_colder_than_the_sky_is_left_to_the_classifier() {
-        let det = AutoV2::default();
+        // Stage 2c alone: the warm face's rectangle is also an outline (stage 5f), rated
+        // above the stage's confidence.
+        let det = AutoV2 {
+            outline: false,
+            ..AutoV2::default()
+        };
         let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
         let px = shaded_sky_with(120, 90, 180, 140, -200);
         let frame = Frame::reference(&px).unwrap();

@@ -24,7 +24,8 @@
 //! of [`FRONTIER_BLOCKS`] block indices (1 KiB) and the [`MAX_SEGMENTS`] segments
 //! (16 B each, 1 536 B).
 //! Cost: per pixel one 2×2 gradient (4 reads) against the seed threshold; per block
-//! added to a region a square root and its 8 neighbours' gradients.
+//! added to a region a square root and its 8 neighbours' gradients, at most
+//! [`MAX_FRAME_BLOCKS`] blocks per frame.
 
 use crate::frame::Frame;
 
@@ -67,6 +68,15 @@ pub const MAX_REGION_BLOCKS: u32 = 4096;
 
 /// Fewest blocks of a region read as a segment (a 10-px edge 1 px wide).
 const MIN_REGION_BLOCKS: u32 = 10;
+
+/// Blocks taken into regions per frame, at most: the detector stops there (the
+/// segments found so far stand). A real frame's segments hold up to 3 535 blocks
+/// (session 55: famA, famAT, famB, famBW, fixtures A, paper A, the real Earth), its
+/// regions a few thousand more; a frame of edges everywhere (`plate-holes-2` of the
+/// worst-case set: every block an edge) would take every one of its 81 000 blocks,
+/// each testing 8 neighbours: 80 M Cortex-M7 instructions before this cap, about
+/// 2.4 M with it (≈ 290 per block).
+pub const MAX_FRAME_BLOCKS: u32 = 8192;
 
 /// `cos(ANGLE_TOLERANCE_DEG)`.
 const COS_TOLERANCE: f32 = 0.923_879_5;
@@ -170,11 +180,12 @@ impl Region {
         self.dyy += oy * oy;
     }
 
-    /// Whether unit direction (ux, uy) lies within the tolerance of the mean direction.
-    fn agrees(&self, ux: f32, uy: f32) -> bool {
-        let dot = ux * self.sx + uy * self.sy;
+    /// Whether gradient (gx, gy) of squared magnitude `m2` lies within the tolerance of
+    /// the mean direction (no square root: `(g·S)² ≥ cos²τ |g|² |S|²` with `g·S > 0`).
+    fn agrees(&self, gx: f32, gy: f32, m2: f32) -> bool {
+        let dot = gx * self.sx + gy * self.sy;
         let norm2 = self.sx * self.sx + self.sy * self.sy;
-        dot > 0.0 && dot * dot >= COS_TOLERANCE * COS_TOLERANCE * norm2
+        dot > 0.0 && dot * dot >= COS_TOLERANCE * COS_TOLERANCE * m2 * norm2
     }
 
     /// The region as a segment (seed block at (x, y)), or `None` when it is too short,
@@ -238,8 +249,16 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
     let seed2 = (i64::from(SEED_SIGMAS) * unit).pow(2);
     let mut found = 0usize;
     let mut frontier = [0u32; FRONTIER_BLOCKS];
+    // Blocks the frame's regions may still take (`MAX_FRAME_BLOCKS`).
+    let mut left = MAX_FRAME_BLOCKS;
     for y in 0..h - 1 {
+        if left == 0 {
+            break;
+        }
         for x in 0..w - 1 {
+            if left == 0 {
+                break;
+            }
             let i = y * w + x;
             let (gx, gy) = gradient(px, w, i, top);
             let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
@@ -259,9 +278,10 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
             };
             region.add(gx as f32 / m, gy as f32 / m, 0, 0);
             marks.set(i);
+            left -= 1;
             frontier[0] = i as u32;
             let mut len = 1usize;
-            while len > 0 && region.n < MAX_REGION_BLOCKS {
+            while len > 0 && region.n < MAX_REGION_BLOCKS && left > 0 {
                 len -= 1;
                 let p = frontier.get(len).copied().unwrap_or(0) as usize;
                 let (px_, py_) = (p % w, p / w);
@@ -279,12 +299,14 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
                     if m2 < edge2 {
                         continue;
                     }
-                    let m = libm::sqrtf(m2 as f32);
-                    let (ux, uy) = (gx as f32 / m, gy as f32 / m);
-                    if !region.agrees(ux, uy) {
+                    let (fx, fy, fm2) = (gx as f32, gy as f32, m2 as f32);
+                    if !region.agrees(fx, fy, fm2) || left == 0 {
                         continue;
                     }
+                    let m = libm::sqrtf(fm2);
+                    let (ux, uy) = (fx / m, fy / m);
                     marks.set(q);
+                    left -= 1;
                     region.add(ux, uy, qx as i64 - x as i64, qy as i64 - y as i64);
                     if let Some(slot) = frontier.get_mut(len) {
                         *slot = q as u32;
