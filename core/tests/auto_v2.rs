@@ -694,8 +694,9 @@ fn an_outline_replaces_a_weaker_answer_and_only_that() {
             ..AutoV2::default()
         };
         let before = without.detect(&f, &mut scratch).unwrap();
-        // Stage 2c's box over deep space stands.
-        let deep_space_box = before.roi.is_some() && scratch.work().deep_space().is_some();
+        // Where stage 2c boxed a target over deep space (above the gate or not), its
+        // answer stands.
+        let deep_space_box = scratch.work().deep_space().is_some();
         let after = AutoV2::default().detect(&f, &mut scratch).unwrap();
         let mut segs = [Segment::default(); segments::MAX_SEGMENTS];
         let n = frame_segments(&f, &mut part_work, &mut segs);

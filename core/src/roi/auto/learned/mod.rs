@@ -1499,12 +1499,13 @@ impl AutoV2 {
         let d = self.regions_and_spots(frame, work, win, plane8, lv);
         // Stage 5f: a straight outline competes with a weak answer or none, on a
         // whole-frame search (in a tracking window the prior says where the target is),
-        // but not with stage 2c's box over deep space: there the fitted sky gives every
-        // departing cell (family A: 11 such boxes an outline rated higher would replace,
-        // mean IoU 0.91 → 0.70).
+        // but not where stage 2c boxed a target over deep space (whether or not its box
+        // passed the gate, so that the answer above the gate does not depend on it):
+        // there the fitted sky gives every departing cell (family A: 11 such boxes an
+        // outline rated higher would replace, mean IoU 0.91 → 0.70).
         if !self.outline
             || !win.is_full(frame)
-            || d.roi.is_some() && work.deep_space.is_some()
+            || work.deep_space.is_some()
             || d.roi.is_some() && d.score_permille >= polygon::MAX_SCORE_PERMILLE
             || polygon::MAX_SCORE_PERMILLE < self.min_score_permille
         {
