@@ -145,12 +145,14 @@ impl<'a> Marks<'a> {
 }
 
 /// The gradient of the 2×2 block at (x, y)..(x + 1, y + 1), `i = y·width + x`, DN
-/// clamped to `top`: `(b + d − a − c, c + d − a − b)`.
+/// clamped to `top`: `(b + d − a − c, c + d − a − b)` (0 off the pixels).
 #[inline(always)]
 fn gradient(px: &[u16], width: usize, i: usize, top: u16) -> (i32, i32) {
-    let at = |k: usize| i32::from(px.get(k).copied().unwrap_or(0).min(top));
-    let (a, b) = (at(i), at(i + 1));
-    let (c, d) = (at(i + width), at(i + width + 1));
+    let pair = |k: usize| match px.get(k..k + 2) {
+        Some(&[p, q]) => (i32::from(p.min(top)), i32::from(q.min(top))),
+        _ => (0, 0),
+    };
+    let ((a, b), (c, d)) = (pair(i), pair(i + width));
     (b + d - a - c, c + d - a - b)
 }
 
@@ -251,17 +253,29 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
     let mut frontier = [0u32; FRONTIER_BLOCKS];
     // Blocks the frame's regions may still take (`MAX_FRAME_BLOCKS`).
     let mut left = MAX_FRAME_BLOCKS;
-    for y in 0..h - 1 {
-        if left == 0 {
+    // |g| ≤ |gx| + |gy|: a block under the seed threshold in that sum is no seed (the
+    // scan's cheap test; most blocks stop there).
+    let seed_l1 = i64::from(SEED_SIGMAS) * unit;
+    let edge_l1 = i64::from(EDGE_SIGMAS) * unit;
+    'rows: for y in 0..h - 1 {
+        let (Some(r0), Some(r1)) = (frame.row(y), frame.row(y + 1)) else {
             break;
-        }
-        for x in 0..w - 1 {
-            if left == 0 {
-                break;
+        };
+        // The block's left column (a over c) carried from the last block's right one.
+        let clamp = |v: &u16| i32::from((*v).min(top));
+        let (mut a, mut c) = (r0.first().map_or(0, clamp), r1.first().map_or(0, clamp));
+        for (x, (b, d)) in r0.iter().skip(1).zip(r1.iter().skip(1)).enumerate() {
+            let (b, d) = (clamp(b), clamp(d));
+            let (gx, gy) = (b + d - a - c, c + d - a - b);
+            (a, c) = (b, d);
+            if i64::from(gx.abs() + gy.abs()) < seed_l1 {
+                continue;
             }
-            let i = y * w + x;
-            let (gx, gy) = gradient(px, w, i, top);
+            if left == 0 {
+                break 'rows;
+            }
             let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
+            let i = y * w + x;
             if m2 < seed2 || marks.get(i) {
                 continue;
             }
@@ -296,7 +310,10 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
                     }
                     let (gx, gy) = gradient(px, w, q, top);
                     let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
-                    if m2 < edge2 {
+                    if i64::from(gx.abs() + gy.abs()) < edge_l1 || m2 < edge2 {
+                        // No edge: no region takes it and it seeds none (the seed
+                        // threshold is higher), so it is marked and never read again.
+                        marks.set(q);
                         continue;
                     }
                     let (fx, fy, fm2) = (gx as f32, gy as f32, m2 as f32);
