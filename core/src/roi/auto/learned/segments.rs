@@ -243,95 +243,43 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
     if w < 2 || h < 2 || out.is_empty() {
         return 0;
     }
-    let px = frame.pixels();
     let top = frame.max_dn();
     // Component noise 2σ; thresholds on the squared magnitude.
     let unit = 2 * i64::from(sigma.max(1));
     let edge2 = (i64::from(EDGE_SIGMAS) * unit).pow(2);
     let seed2 = (i64::from(SEED_SIGMAS) * unit).pow(2);
     let mut found = 0usize;
-    let mut frontier = [0u32; FRONTIER_BLOCKS];
-    // Blocks the frame's regions may still take (`MAX_FRAME_BLOCKS`).
-    let mut left = MAX_FRAME_BLOCKS;
     // |g| ≤ |gx| + |gy|: a block under the seed threshold in that sum is no seed (the
     // scan's cheap test; most blocks stop there).
     let seed_l1 = i64::from(SEED_SIGMAS) * unit;
     let edge_l1 = i64::from(EDGE_SIGMAS) * unit;
-    'rows: for y in 0..h - 1 {
+    let seed_l1 = i32::try_from(seed_l1).unwrap_or(i32::MAX);
+    let mut grower = Grower {
+        px: frame.pixels(),
+        w,
+        h,
+        top,
+        edge_l1,
+        edge2,
+        frontier: [0u32; FRONTIER_BLOCKS],
+        left: MAX_FRAME_BLOCKS,
+    };
+    for y in 0..h - 1 {
         let (Some(r0), Some(r1)) = (frame.row(y), frame.row(y + 1)) else {
             break;
         };
-        // The block's left column (a over c) carried from the last block's right one.
-        let clamp = |v: &u16| i32::from((*v).min(top));
-        let (mut a, mut c) = (r0.first().map_or(0, clamp), r1.first().map_or(0, clamp));
-        for (x, (b, d)) in r0.iter().skip(1).zip(r1.iter().skip(1)).enumerate() {
-            let (b, d) = (clamp(b), clamp(d));
-            let (gx, gy) = (b + d - a - c, c + d - a - b);
-            (a, c) = (b, d);
-            if i64::from(gx.abs() + gy.abs()) < seed_l1 {
-                continue;
-            }
-            if left == 0 {
-                break 'rows;
+        let mut from = 0;
+        while let Some((x, gx, gy)) = next_seed(r0, r1, from, top, seed_l1) {
+            from = x + 1;
+            if grower.left == 0 {
+                return found;
             }
             let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
             let i = y * w + x;
             if m2 < seed2 || marks.get(i) {
                 continue;
             }
-            let m = libm::sqrtf(m2 as f32);
-            let mut region = Region {
-                sx: 0.0,
-                sy: 0.0,
-                n: 0,
-                dx: 0,
-                dy: 0,
-                dxx: 0,
-                dxy: 0,
-                dyy: 0,
-            };
-            region.add(gx as f32 / m, gy as f32 / m, 0, 0);
-            marks.set(i);
-            left -= 1;
-            frontier[0] = i as u32;
-            let mut len = 1usize;
-            while len > 0 && region.n < MAX_REGION_BLOCKS && left > 0 {
-                len -= 1;
-                let p = frontier.get(len).copied().unwrap_or(0) as usize;
-                let (px_, py_) = (p % w, p / w);
-                for (ox, oy) in NEIGHBOURS {
-                    let (qx, qy) = (px_ as isize + ox, py_ as isize + oy);
-                    if qx < 0 || qy < 0 || qx as usize >= w - 1 || qy as usize >= h - 1 {
-                        continue;
-                    }
-                    let q = qy as usize * w + qx as usize;
-                    if marks.get(q) {
-                        continue;
-                    }
-                    let (gx, gy) = gradient(px, w, q, top);
-                    let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
-                    if i64::from(gx.abs() + gy.abs()) < edge_l1 || m2 < edge2 {
-                        // No edge: no region takes it and it seeds none (the seed
-                        // threshold is higher), so it is marked and never read again.
-                        marks.set(q);
-                        continue;
-                    }
-                    let (fx, fy, fm2) = (gx as f32, gy as f32, m2 as f32);
-                    if !region.agrees(fx, fy, fm2) || left == 0 {
-                        continue;
-                    }
-                    let m = libm::sqrtf(fm2);
-                    let (ux, uy) = (fx / m, fy / m);
-                    marks.set(q);
-                    left -= 1;
-                    region.add(ux, uy, qx as i64 - x as i64, qy as i64 - y as i64);
-                    if let Some(slot) = frontier.get_mut(len) {
-                        *slot = q as u32;
-                        len += 1;
-                    }
-                }
-            }
-            let Some(s) = region.segment(x, y) else {
+            let Some(s) = grower.segment_from(marks, x, y, gx, gy, m2) else {
                 continue;
             };
             if found < out.len() {
@@ -347,6 +295,116 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
         }
     }
     found
+}
+
+/// The first block of the row pair `r0` over `r1` at or after column `from` whose
+/// |gx| + |gy| reaches `seed_l1` (|g| ≤ |gx| + |gy|: every seed passes), with its
+/// gradient; `None` when the row holds no more. The scan's one tight loop: the block's
+/// left column (a over c) carried from the last block's right one.
+#[inline(always)]
+fn next_seed(
+    r0: &[u16],
+    r1: &[u16],
+    from: usize,
+    top: u16,
+    seed_l1: i32,
+) -> Option<(usize, i32, i32)> {
+    let (r0, r1) = (r0.get(from..)?, r1.get(from..)?);
+    let clamp = |v: &u16| i32::from((*v).min(top));
+    let (mut a, mut c) = (clamp(r0.first()?), clamp(r1.first()?));
+    for (k, (b, d)) in r0.iter().skip(1).zip(r1.iter().skip(1)).enumerate() {
+        let (b, d) = (clamp(b), clamp(d));
+        let (gx, gy) = (b + d - a - c, c + d - a - b);
+        if gx.abs() + gy.abs() >= seed_l1 {
+            return Some((from + k, gx, gy));
+        }
+        (a, c) = (b, d);
+    }
+    None
+}
+
+/// What growing a region needs: the frame, the edge thresholds, the frontier and the
+/// blocks the frame's regions may still take ([`MAX_FRAME_BLOCKS`]).
+struct Grower<'a> {
+    px: &'a [u16],
+    w: usize,
+    h: usize,
+    top: u16,
+    edge_l1: i64,
+    edge2: i64,
+    frontier: [u32; FRONTIER_BLOCKS],
+    left: u32,
+}
+
+impl Grower<'_> {
+    /// The region grown from the seed block at (x, y) (gradient (gx, gy), squared
+    /// magnitude `m2`), as a segment when it is one; its blocks are marked.
+    #[inline(never)]
+    fn segment_from(
+        &mut self,
+        marks: &mut Marks<'_>,
+        x: usize,
+        y: usize,
+        gx: i32,
+        gy: i32,
+        m2: i64,
+    ) -> Option<Segment> {
+        let (w, h) = (self.w, self.h);
+        let i = y * w + x;
+        let m = libm::sqrtf(m2 as f32);
+        let mut region = Region {
+            sx: 0.0,
+            sy: 0.0,
+            n: 0,
+            dx: 0,
+            dy: 0,
+            dxx: 0,
+            dxy: 0,
+            dyy: 0,
+        };
+        region.add(gx as f32 / m, gy as f32 / m, 0, 0);
+        marks.set(i);
+        self.left -= 1;
+        self.frontier[0] = i as u32;
+        let mut len = 1usize;
+        while len > 0 && region.n < MAX_REGION_BLOCKS && self.left > 0 {
+            len -= 1;
+            let p = self.frontier.get(len).copied().unwrap_or(0) as usize;
+            let (px_, py_) = (p % w, p / w);
+            for (ox, oy) in NEIGHBOURS {
+                let (qx, qy) = (px_ as isize + ox, py_ as isize + oy);
+                if qx < 0 || qy < 0 || qx as usize >= w - 1 || qy as usize >= h - 1 {
+                    continue;
+                }
+                let q = qy as usize * w + qx as usize;
+                if marks.get(q) {
+                    continue;
+                }
+                let (gx, gy) = gradient(self.px, w, q, self.top);
+                let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
+                if i64::from(gx.abs() + gy.abs()) < self.edge_l1 || m2 < self.edge2 {
+                    // No edge: no region takes it and it seeds none (the seed
+                    // threshold is higher), so it is marked and never read again.
+                    marks.set(q);
+                    continue;
+                }
+                let (fx, fy, fm2) = (gx as f32, gy as f32, m2 as f32);
+                if !region.agrees(fx, fy, fm2) || self.left == 0 {
+                    continue;
+                }
+                let m = libm::sqrtf(fm2);
+                let (ux, uy) = (fx / m, fy / m);
+                marks.set(q);
+                self.left -= 1;
+                region.add(ux, uy, qx as i64 - x as i64, qy as i64 - y as i64);
+                if let Some(slot) = self.frontier.get_mut(len) {
+                    *slot = q as u32;
+                    len += 1;
+                }
+            }
+        }
+        region.segment(x, y)
+    }
 }
 
 /// The 8 neighbours' offsets.
