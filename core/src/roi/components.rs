@@ -17,6 +17,20 @@
 
 use core::marker::PhantomData;
 
+/// The offsets (dx, dy) of a pixel's (or cell's) 8 neighbours, row by row: the
+/// 8-connectivity both the spot search's refinement and the segment detector's region
+/// growth walk.
+pub(crate) const NEIGHBOURS_8: [(isize, isize); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
 use crate::capacity::{Buffer, ConstInit};
 
 /// A component label: an index into the tables.

@@ -280,8 +280,10 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
         }
     }
     // Pixels whose centres lie inside the ends' box (an edge lies between two pixels).
-    let lo = |q: i16, n: usize| (i32::from(q) + 3).div_euclid(4).clamp(0, n as i32 - 1) as u16;
-    let hi = |q: i16, n: usize| i32::from(q).div_euclid(4).clamp(0, n as i32 - 1) as u16;
+    // (`max`/`min`, not `clamp`, whose bounds check is a panic path.)
+    let last = |n: usize| n.saturating_sub(1).min(usize::from(u16::MAX)) as i32;
+    let lo = |q: i16, n: usize| (i32::from(q) + 3).div_euclid(4).max(0).min(last(n)) as u16;
+    let hi = |q: i16, n: usize| i32::from(q).div_euclid(4).max(0).min(last(n)) as u16;
     let (x0, y0) = (lo(b.x0_q, width), lo(b.y0_q, height));
     let (x1, y1) = (hi(b.x1_q, width).max(x0), hi(b.y1_q, height).max(y0));
     Some(Outline {

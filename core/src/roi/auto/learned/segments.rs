@@ -28,6 +28,7 @@
 //! [`MAX_FRAME_BLOCKS`] blocks per frame.
 
 use crate::frame::Frame;
+use crate::roi::components::NEIGHBOURS_8;
 
 /// Segments kept per frame: the longest when more are found. A spacecraft's outline
 /// and face boundaries give 3–12 segments of ≥ 10 px (famA's radiometry-close frames,
@@ -371,7 +372,7 @@ impl Grower<'_> {
             len -= 1;
             let p = self.frontier.get(len).copied().unwrap_or(0) as usize;
             let (px_, py_) = (p % w, p / w);
-            for (ox, oy) in NEIGHBOURS {
+            for (ox, oy) in NEIGHBOURS_8 {
                 let (qx, qy) = (px_ as isize + ox, py_ as isize + oy);
                 if qx < 0 || qy < 0 || qx as usize >= w - 1 || qy as usize >= h - 1 {
                     continue;
@@ -406,18 +407,6 @@ impl Grower<'_> {
         region.segment(x, y)
     }
 }
-
-/// The 8 neighbours' offsets.
-const NEIGHBOURS: [(isize, isize); 8] = [
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-    (-1, 0),
-    (1, 0),
-    (-1, 1),
-    (0, 1),
-    (1, 1),
-];
 
 #[cfg(test)]
 mod tests {

@@ -46,6 +46,7 @@ use super::narrow::isqrt_u64;
 use super::spot_trees;
 use crate::frame::Frame;
 use crate::roi::Roi;
+use crate::roi::components::NEIGHBOURS_8;
 use crate::roi::plane::Window;
 
 /// Spots rated per frame: the strongest, at least [`SEPARATION_PX`] apart. 8, chosen on
@@ -610,16 +611,7 @@ pub(crate) fn strongest_spots(
     for slot in list.iter_mut() {
         let Some(s) = slot else { continue };
         let (x, y) = (usize::from(s.x), usize::from(s.y));
-        for (dx, dy) in [
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-            (-1, 0),
-            (1, 0),
-            (-1, 1),
-            (0, 1),
-            (1, 1),
-        ] {
+        for (dx, dy) in NEIGHBOURS_8 {
             let (Some(xx), Some(yy)) = (x.checked_add_signed(dx), y.checked_add_signed(dy)) else {
                 continue;
             };
