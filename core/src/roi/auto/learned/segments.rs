@@ -371,7 +371,8 @@ impl Grower<'_> {
         while len > 0 && region.n < MAX_REGION_BLOCKS && self.left > 0 {
             len -= 1;
             let p = self.frontier.get(len).copied().unwrap_or(0) as usize;
-            let (px_, py_) = (p % w, p / w);
+            // (`w ≥ 2` by `detect`; `max(1)` says so to the compiler: no division panic.)
+            let (px_, py_) = (p % w.max(1), p / w.max(1));
             for (ox, oy) in NEIGHBOURS_8 {
                 let (qx, qy) = (px_ as isize + ox, py_ as isize + oy);
                 if qx < 0 || qy < 0 || qx as usize >= w - 1 || qy as usize >= h - 1 {
