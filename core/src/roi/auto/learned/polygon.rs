@@ -314,16 +314,20 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_dark_rectangle_is_an_outline() {
-        // Sides of a dark 60 × 40 rectangle at (29.5, 24.5)–(89.5, 64.5), gradients
-        // outwards, ends 1–2 px short of the corners.
-        let sides = [
+    /// Sides of a dark 60 × 40 rectangle at (29.5, 24.5)–(89.5, 64.5), gradients
+    /// outwards, ends 1–2 px short of the corners: top, bottom, left, right.
+    fn dark_rectangle() -> [Segment; 4] {
+        [
             seg(31.0, 24.5, 88.0, 24.5, 0.0, -1.0),
             seg(31.0, 64.5, 88.0, 64.5, 0.0, 1.0),
             seg(29.5, 26.0, 29.5, 63.0, -1.0, 0.0),
             seg(89.5, 26.0, 89.5, 63.0, 1.0, 0.0),
-        ];
+        ]
+    }
+
+    #[test]
+    fn a_dark_rectangle_is_an_outline() {
+        let sides = dark_rectangle();
         let o = strongest(&sides, 120, 90).unwrap();
         assert_eq!((o.segments, o.corners), (4, 4), "{o:?}");
         assert_eq!(
@@ -347,12 +351,7 @@ mod tests {
         // The dark rectangle and, to its right, a narrower dark part (a cylinder) from
         // x 89.5 to 119.5, y 34.5–55.5: its long sides end on the body's right side (a
         // T, not a corner) and meet its own far end at corners.
-        let body = [
-            seg(31.0, 24.5, 88.0, 24.5, 0.0, -1.0),
-            seg(31.0, 64.5, 88.0, 64.5, 0.0, 1.0),
-            seg(29.5, 26.0, 29.5, 63.0, -1.0, 0.0),
-            seg(89.5, 26.0, 89.5, 63.0, 1.0, 0.0),
-        ];
+        let body = dark_rectangle();
         let part = [
             seg(91.0, 34.5, 118.0, 34.5, 0.0, -1.0),
             seg(91.0, 55.5, 118.0, 55.5, 0.0, 1.0),
@@ -396,8 +395,7 @@ mod tests {
     fn edges_that_disagree_at_a_corner_or_run_apart_are_no_outline() {
         // The top side and the left side of a dark rectangle meet; the left side's
         // gradient flipped (a brighter region to its right) breaks the corner.
-        let top = seg(31.0, 24.5, 88.0, 24.5, 0.0, -1.0);
-        let left = seg(29.5, 26.0, 29.5, 63.0, -1.0, 0.0);
+        let [top, _, left, _] = dark_rectangle();
         assert!(strongest(&[top, left], 120, 90).is_some());
         let flipped = seg(29.5, 26.0, 29.5, 63.0, 1.0, 0.0);
         assert!(strongest(&[top, flipped], 120, 90).is_none());
@@ -417,12 +415,13 @@ mod tests {
     fn a_broken_side_continues_its_outline() {
         // The bottom side in two pieces (a gap of 4 px), joined along the line; the
         // group holds all five segments.
+        let [top, _, left, right] = dark_rectangle();
         let sides = [
-            seg(31.0, 24.5, 88.0, 24.5, 0.0, -1.0),
+            top,
             seg(31.0, 64.5, 55.0, 64.5, 0.0, 1.0),
             seg(59.0, 64.6, 88.0, 64.5, 0.0, 1.0),
-            seg(29.5, 26.0, 29.5, 63.0, -1.0, 0.0),
-            seg(89.5, 26.0, 89.5, 63.0, 1.0, 0.0),
+            left,
+            right,
         ];
         let o = strongest(&sides, 120, 90).unwrap();
         assert_eq!(o.segments, 5, "{o:?}");
