@@ -174,10 +174,11 @@ pub struct AutoV2 {
     /// "no target" or rated below [`polygon::MAX_SCORE_PERMILLE`], the frame's straight
     /// outline — long straight edges meeting at agreeing corners — is the answer when
     /// it has one rated higher ([`polygon::Outline::score_permille`]) and passing the
-    /// gate. Default on: on family A (seeds
-    /// 7001, 7101, 7201) radiometry close 0.357 → 0.53, the Tango close row 0.383 →
-    /// 0.47, no false alarm added on famAE (`docs/detectors.md` § Session 55). It
-    /// costs one pass of the segment detector ([`segments`]) on those frames.
+    /// gate. Default on: on family A (seeds 7001, 7101, 7201) summed mean IoU +0.054,
+    /// famA's radiometry close 0.382 → 0.553, the Tango close set 0.383 → 0.475, no false
+    /// alarm added on famAE (fixtures A: 1 of 80; `docs/detectors.md` § Session 55). It
+    /// costs one pass of the segment detector ([`segments`]) on those frames (the
+    /// flight demo's Tango frame +3.3 M Cortex-M7 instructions).
     pub outline: bool,
     /// Stage 4c: after the confidence rated the winner, target cells of other
     /// components up to this many cells from the winner's (Chebyshev) join it where

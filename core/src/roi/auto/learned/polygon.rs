@@ -52,8 +52,9 @@ pub const MAX_CONTINUATION_DEG: f32 = 10.0;
 /// Farthest a continuation's middle may lie from the first piece's line, pixels.
 pub const CONTINUATION_OFFSET_PX: i32 = 2;
 
-/// Shortest outline (its segments' summed length), pixels. Chosen on family A (seed
-/// 7001; the stage competing with answers under its confidence): 50 / 60 / 80 px →
+/// Shortest outline (its segments' summed length), pixels. Chosen on family A (seeds
+/// 7001, 7101, 7201; the stage's first form — one confidence, 750 ‰, no joined groups —
+/// replayed offline on this detector's segments): 50 / 60 / 80 px →
 /// summed mean IoU of famA, paperA, fixA and famAF +0.038 / +0.035 / +0.029, famAT
 /// +0.091 / +0.068 / +0.035, no false alarm added on famAE and 1 of fixA's 80
 /// no-target frames (a fixture's aliased limb, a staircase of horizontal pieces, with
