@@ -26,11 +26,13 @@
 //! 50 px.
 //!
 //! Memory: on the stack the group of each segment (1 B each) and the groups' sums
-//! (16 B each): 1 632 B for [`MAX_SEGMENTS`]; no scratch.
+//! (16 B each) in the union-find: 1 632 B for [`MAX_SEGMENTS`]; no scratch.
 //! Cost: every pair of segments once (at most 4 560 pairs for 96).
 
 use super::segments::{DIRECTION_ONE, MAX_SEGMENTS, Segment};
+use crate::capacity::ConstInit;
 use crate::roi::Roi;
+use crate::roi::components::{Components, Stats};
 
 /// Farthest apart two segments' ends may lie to meet, pixels: the optics blur a corner
 /// over 2–3 px and each segment's ends are read from its blocks' spread (within a
@@ -176,24 +178,9 @@ fn meeting(a: &Segment, b: &Segment, corner_cos2: i64, continuation_cos2: i64) -
     None
 }
 
-/// The group root of `i` (path halving).
-fn root(parent: &mut [u8; MAX_SEGMENTS], mut i: usize) -> usize {
-    while let Some(&p) = parent.get(i) {
-        let p = usize::from(p);
-        if p == i {
-            break;
-        }
-        let gp = parent.get(p).copied().unwrap_or(p as u8);
-        if let Some(slot) = parent.get_mut(i) {
-            *slot = gp;
-        }
-        i = usize::from(gp);
-    }
-    i
-}
-
-/// A group's sums.
-#[derive(Clone, Copy)]
+/// A group's sums: its segments' summed length, count, corners and the box of their
+/// ends (quarter pixels).
+#[derive(Debug, Clone, Copy)]
 struct Group {
     length_q: u32,
     segments: u8,
@@ -204,6 +191,57 @@ struct Group {
     y1_q: i16,
 }
 
+impl Group {
+    /// Segment `s` alone.
+    fn of(s: &Segment) -> Self {
+        Group {
+            length_q: u32::from(s.length_q),
+            segments: 1,
+            corners: 0,
+            x0_q: s.x0_q.min(s.x1_q),
+            y0_q: s.y0_q.min(s.y1_q),
+            x1_q: s.x0_q.max(s.x1_q),
+            y1_q: s.y0_q.max(s.y1_q),
+        }
+    }
+
+    /// Whether `other`'s box reaches within `reach_q` quarter pixels of this one's.
+    fn reaches(&self, other: &Group, reach_q: i16) -> bool {
+        other.x0_q <= self.x1_q + reach_q
+            && other.x1_q >= self.x0_q - reach_q
+            && other.y0_q <= self.y1_q + reach_q
+            && other.y1_q >= self.y0_q - reach_q
+    }
+}
+
+impl ConstInit for Group {
+    const INIT: Self = Group {
+        length_q: 0,
+        segments: 0,
+        corners: 0,
+        x0_q: i16::MAX,
+        y0_q: i16::MAX,
+        x1_q: i16::MIN,
+        y1_q: i16::MIN,
+    };
+}
+
+impl Stats for Group {
+    fn merge(&mut self, other: &Self) {
+        self.length_q = self.length_q.saturating_add(other.length_q);
+        self.segments = self.segments.saturating_add(other.segments);
+        self.corners = self.corners.saturating_add(other.corners);
+        self.x0_q = self.x0_q.min(other.x0_q);
+        self.y0_q = self.y0_q.min(other.y0_q);
+        self.x1_q = self.x1_q.max(other.x1_q);
+        self.y1_q = self.y1_q.max(other.y1_q);
+    }
+}
+
+/// The groups of the segments: the project's union-find ([`Components`]), one label per
+/// segment, the statistics merged on union.
+type Groups = Components<u8, Group, [u8; MAX_SEGMENTS], [Group; MAX_SEGMENTS]>;
+
 /// The frame's outline among `segments` (a `width` × `height` frame): the group with a
 /// corner and the longest edges, when they reach [`MIN_OUTLINE_PX`]; `None` otherwise.
 pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Outline> {
@@ -211,73 +249,41 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
     let segments = segments.get(..n)?;
     let corner_cos2 = cos2_scaled(MIN_CORNER_DEG);
     let continuation_cos2 = cos2_scaled(MAX_CONTINUATION_DEG);
-    let mut parent = [0u8; MAX_SEGMENTS];
-    for (i, p) in parent.iter_mut().enumerate() {
-        *p = i as u8;
+    let mut groups = Groups::INIT;
+    for (i, s) in segments.iter().enumerate() {
+        groups.make_set(i as u8, Group::of(s));
     }
-    let mut corners = [0u8; MAX_SEGMENTS];
     for (i, a) in segments.iter().enumerate() {
         for (j, b) in segments.iter().enumerate().skip(i + 1) {
             let Some(corner) = meeting(a, b, corner_cos2, continuation_cos2) else {
                 continue;
             };
-            let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
-            if let Some(slot) = parent.get_mut(ri) {
-                *slot = rj as u8;
-            }
-            if corner {
-                if let Some(c) = corners.get_mut(i) {
-                    *c = c.saturating_add(1);
-                }
+            let (ri, rj) = (groups.find(i as u8), groups.find(j as u8));
+            let root = groups.union(ri, rj);
+            if let (true, Some(g)) = (corner, groups.stats_mut(usize::from(root))) {
+                g.corners = g.corners.saturating_add(1);
             }
         }
     }
-    let mut groups = [None::<Group>; MAX_SEGMENTS];
-    for (i, s) in segments.iter().enumerate() {
-        let r = root(&mut parent, i);
-        let c = corners.get(i).copied().unwrap_or(0);
-        let Some(slot) = groups.get_mut(r) else {
-            continue;
-        };
-        let g = slot.get_or_insert(Group {
-            length_q: 0,
-            segments: 0,
-            corners: 0,
-            x0_q: i16::MAX,
-            y0_q: i16::MAX,
-            x1_q: i16::MIN,
-            y1_q: i16::MIN,
-        });
-        g.length_q += u32::from(s.length_q);
-        g.segments = g.segments.saturating_add(1);
-        g.corners = g.corners.saturating_add(c);
-        g.x0_q = g.x0_q.min(s.x0_q).min(s.x1_q);
-        g.y0_q = g.y0_q.min(s.y0_q).min(s.y1_q);
-        g.x1_q = g.x1_q.max(s.x0_q).max(s.x1_q);
-        g.y1_q = g.y1_q.max(s.y0_q).max(s.y1_q);
-    }
-    let best = *groups
-        .iter()
-        .flatten()
-        .filter(|g| g.corners > 0)
-        .max_by_key(|g| g.length_q)?;
+    // The groups with a corner (their roots' statistics).
+    let cornered = || {
+        (0..n)
+            .filter(|&l| groups.parent(l) == Some(l as u8))
+            .filter_map(|l| groups.stats(l).copied())
+            .filter(|g| g.corners > 0)
+    };
+    let best = cornered().max_by_key(|g| g.length_q)?;
     let length_px = best.length_q / 4;
     if length_px < MIN_OUTLINE_PX || width == 0 || height == 0 {
         return None;
     }
-    // The other groups with a corner that reach the box (quarter pixels).
-    let reach = (ABSORB_REACH_PX * 4) as i16;
+    // The other groups with a corner that reach the box take part in it (its box only:
+    // the outline's length, segments and corners stay its own group's).
+    let reach_q = (ABSORB_REACH_PX * 4) as i16;
     let mut b = best;
-    for g in groups.iter().flatten().filter(|g| g.corners > 0) {
-        if g.x0_q <= best.x1_q + reach
-            && g.x1_q >= best.x0_q - reach
-            && g.y0_q <= best.y1_q + reach
-            && g.y1_q >= best.y0_q - reach
-        {
-            b.x0_q = b.x0_q.min(g.x0_q);
-            b.y0_q = b.y0_q.min(g.y0_q);
-            b.x1_q = b.x1_q.max(g.x1_q);
-            b.y1_q = b.y1_q.max(g.y1_q);
+    for g in cornered() {
+        if best.reaches(&g, reach_q) {
+            b.merge(&g);
         }
     }
     // Pixels whose centres lie inside the ends' box (an edge lies between two pixels).

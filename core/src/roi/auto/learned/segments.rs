@@ -252,15 +252,12 @@ pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [S
     let mut found = 0usize;
     // |g| ≤ |gx| + |gy|: a block under the seed threshold in that sum is no seed (the
     // scan's cheap test; most blocks stop there).
-    let seed_l1 = i64::from(SEED_SIGMAS) * unit;
-    let edge_l1 = i64::from(EDGE_SIGMAS) * unit;
-    let seed_l1 = i32::try_from(seed_l1).unwrap_or(i32::MAX);
+    let seed_l1 = i32::try_from(i64::from(SEED_SIGMAS) * unit).unwrap_or(i32::MAX);
     let mut grower = Grower {
         px: frame.pixels(),
         w,
         h,
         top,
-        edge_l1,
         edge2,
         frontier: [0u32; FRONTIER_BLOCKS],
         left: MAX_FRAME_BLOCKS,
@@ -331,7 +328,6 @@ struct Grower<'a> {
     w: usize,
     h: usize,
     top: u16,
-    edge_l1: i64,
     edge2: i64,
     frontier: [u32; FRONTIER_BLOCKS],
     left: u32,
@@ -384,7 +380,7 @@ impl Grower<'_> {
                 }
                 let (gx, gy) = gradient(self.px, w, q, self.top);
                 let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
-                if i64::from(gx.abs() + gy.abs()) < self.edge_l1 || m2 < self.edge2 {
+                if m2 < self.edge2 {
                     // No edge: no region takes it and it seeds none (the seed
                     // threshold is higher), so it is marked and never read again.
                     marks.set(q);
