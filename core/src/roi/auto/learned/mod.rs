@@ -957,6 +957,63 @@ fn strongest_component<C: FrameCapacity>(
     Some((root, w8, next))
 }
 
+/// Stage 2c's component: the strongest (as [`strongest_component`] chooses); when it
+/// holds no seed (a cell coded above [`smooth::WEAK_CODE`]), the strongest seeded
+/// component of at least [`DEEP_SPACE_FALLBACK_MIN_CELLS`] cells instead, if any
+/// (else the weak one: the stage then hands over, as without it). A band of the
+/// shading's weak residuals along the frame's edge can outweigh a faint target's
+/// seeded cells (`famAT/000023`, `000107`, `000175`, `000223`: 12–320 DN targets over
+/// the shaded sky, each a 3–9-cell seeded component behind a weak band).
+fn deep_space_component<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane8: (usize, usize),
+) -> Option<(u8, CellStats, usize)> {
+    let n8 = plane8.0 * plane8.1;
+    let (root, w8, next) = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
+    // The roots of the components holding a seed (labels are `u8`).
+    let mut seeded = [false; 256];
+    let cells = work.labels8.as_ref().get(..n8)?.iter();
+    for (&l, &code) in cells.zip(work.labels4.as_ref()) {
+        if l != 0 && code > smooth::WEAK_CODE {
+            if let Some(s) = seeded.get_mut(usize::from(work.comps.find(l))) {
+                *s = true;
+            }
+        }
+    }
+    if seeded.get(usize::from(root)).copied().unwrap_or(false) {
+        return Some((root, w8, next));
+    }
+    // The strongest seeded root of enough cells (ties: the lowest label, as
+    // `choose_target`).
+    let mut fallback: Option<(u8, CellStats)> = None;
+    for (l, &is_seeded) in seeded.iter().enumerate().take(next).skip(1) {
+        if !is_seeded || work.comps.parents().get(l) != Some(&(l as u8)) {
+            continue;
+        }
+        let Some(c) = work.comps.stats(l) else {
+            continue;
+        };
+        if usize::from(c.area) >= DEEP_SPACE_FALLBACK_MIN_CELLS
+            && fallback.is_none_or(|(_, b)| c.energy > b.energy)
+        {
+            fallback = Some((l as u8, *c));
+        }
+    }
+    let (root, w8) = fallback.unwrap_or((root, w8));
+    Some((root, w8, next))
+}
+
+/// Fewest cells of the seeded component stage 2c takes when its strongest component
+/// holds no seed ([`deep_space_component`]): smaller seeded components are what the
+/// fitted sky's own texture and shading give there (paper A's far sky, `000128`,
+/// `000135`; famAE's shading edge, `000166`: false alarm), while a small target is
+/// stage 2d's and 5e's. Chosen on family A (seeds 7001–7201, ½ convention, change of
+/// the summed mean IoU of famA, paper A, fixtures A, famAF and famAT): 2 → +0.0129
+/// and one false alarm added (famAE 6 → 7 of 300), **3 → +0.0143** (famAT 0.4753 →
+/// 0.4878, famAF +0.0012, famA +0.0006; no set lower, no false alarm added), 4 →
+/// +0.0106.
+pub const DEEP_SPACE_FALLBACK_MIN_CELLS: usize = 3;
+
 /// Largest [`AutoV2::link_cells`], cells.
 pub const MAX_LINK_CELLS: usize = 3;
 
@@ -1789,7 +1846,8 @@ impl AutoV2 {
     }
 
     /// Stage 2c ([`smooth`]): when the window is deep space, its departing cells'
-    /// strongest component refined as the classifier's winner is (stages 5, 7 and 8,
+    /// strongest component (behind a band of weak cells, a seeded one:
+    /// [`deep_space_component`]) refined as the classifier's winner is (stages 5, 7 and 8,
     /// boundaries of [`DEEP_SPACE_FINE_SIGMA`] σ), with [`DEEP_SPACE_SCORE_PERMILLE`]
     /// (a component cut by one side of the window and shorter along it than
     /// [`EARTH_MIN_CHORD_CELLS`], departing upwards by at least
@@ -1827,7 +1885,7 @@ impl AutoV2 {
             lv.sigma,
             work.sum.as_mut(),
         )?;
-        let Some((root, w8, next)) = strongest_component(work, plane8, CELL_RELABEL_CODES) else {
+        let Some((root, w8, next)) = deep_space_component(work, plane8) else {
             return self
                 .small_target
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
@@ -3067,6 +3125,50 @@ mod tests {
         let frame = Frame::reference(&px).unwrap();
         let d = on.detect(&frame, &mut scratch).unwrap();
         assert!(scratch.work().deep_space().is_none(), "{d:?}");
+    }
+
+    /// Stage 2c's component: behind a stronger band of weak cells (the shading along
+    /// two edges), the strongest seeded component of at least
+    /// [`DEEP_SPACE_FALLBACK_MIN_CELLS`] cells, not a stronger seeded pair; the weak
+    /// band when no seeded component is large enough; the strongest component when
+    /// it is seeded.
+    #[test]
+    fn deep_space_takes_a_seeded_component_behind_a_weak_band() {
+        let (pw, ph) = (41usize, 31usize);
+        let n = pw * ph;
+        let mut work: std::boxed::Box<AutoV2Work> = std::boxed::Box::new(ConstInit::INIT);
+        // (pair code, with the three-cell component): the band of weak cells (code 1)
+        // on the left column and top row weighs 71; a seeded pair at (20, 20)–(21, 20)
+        // and three seeded cells at (30, 10)–(32, 10) (a seed and two weak cells).
+        let setup = |work: &mut AutoV2Work, pair: u8, three: bool| {
+            let codes = &mut work.labels4.as_mut()[..n];
+            codes.fill(0);
+            for y in 0..ph {
+                codes[y * pw] = smooth::WEAK_CODE;
+            }
+            codes[..pw].fill(smooth::WEAK_CODE);
+            codes[20 * pw + 20] = pair;
+            codes[20 * pw + 21] = pair;
+            if three {
+                codes[10 * pw + 30] = smooth::WEAK_CODE + 1;
+                codes[10 * pw + 31] = smooth::WEAK_CODE;
+                codes[10 * pw + 32] = smooth::WEAK_CODE;
+            }
+        };
+        let boxed = |w8: CellStats| (w8.x0, w8.y0, w8.x_last, w8.y_last, w8.area);
+        // The pair (code 48: 8 each) is stronger than the three cells (3), weaker than
+        // the band: the three cells.
+        setup(&mut work, 48, true);
+        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        assert_eq!(boxed(w8), (30, 10, 32, 10, 3));
+        // Without them the weak band stays (the stage then hands over).
+        setup(&mut work, 48, false);
+        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        assert_eq!(boxed(w8), (0, 0, 40, 30, 71));
+        // A pair stronger than the band (code 112: 128 each) is the strongest: taken.
+        setup(&mut work, 112, true);
+        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        assert_eq!(boxed(w8), (20, 20, 21, 20, 2));
     }
 
     /// Stage 4c: the body's scattered target cells (gaps of one cell at the body's
