@@ -960,16 +960,21 @@ fn strongest_component<C: FrameCapacity>(
 /// Stage 2c's component: the strongest (as [`strongest_component`] chooses); when it
 /// holds no seed (a cell coded above [`smooth::WEAK_CODE`]), the strongest seeded
 /// component of at least [`DEEP_SPACE_FALLBACK_MIN_CELLS`] cells instead, if any
-/// (else the weak one: the stage then hands over, as without it). A band of the
+/// (else the weak one: the stage then hands over, as without it), with its
+/// [`Seeds`] (one pass over the cells when the strongest is seeded). A band of the
 /// shading's weak residuals along the frame's edge can outweigh a faint target's
 /// seeded cells (`famAT/000023`, `000107`, `000175`, `000223`: 12–320 DN targets over
 /// the shaded sky, each a 3–9-cell seeded component behind a weak band).
 fn deep_space_component<C: FrameCapacity>(
     work: &mut AutoV2Work<C>,
     plane8: (usize, usize),
-) -> Option<(u8, CellStats, usize)> {
+) -> Option<(u8, CellStats, usize, Seeds)> {
     let n8 = plane8.0 * plane8.1;
     let (root, w8, next) = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
+    let seeds = seeds_of(work, n8, root);
+    if seeds.strongest() > 0 {
+        return Some((root, w8, next, seeds));
+    }
     // The roots of the components holding a seed (labels are `u8`).
     let mut seeded = [false; 256];
     let cells = work.labels8.as_ref().get(..n8)?.iter();
@@ -979,9 +984,6 @@ fn deep_space_component<C: FrameCapacity>(
                 *s = true;
             }
         }
-    }
-    if seeded.get(usize::from(root)).copied().unwrap_or(false) {
-        return Some((root, w8, next));
     }
     // The strongest seeded root of enough cells (ties: the lowest label, as
     // `choose_target`).
@@ -999,8 +1001,10 @@ fn deep_space_component<C: FrameCapacity>(
             fallback = Some((l as u8, *c));
         }
     }
-    let (root, w8) = fallback.unwrap_or((root, w8));
-    Some((root, w8, next))
+    let Some((root, w8)) = fallback else {
+        return Some((root, w8, next, seeds));
+    };
+    Some((root, w8, next, seeds_of(work, n8, root)))
 }
 
 /// Fewest cells of the seeded component stage 2c takes when its strongest component
@@ -1885,7 +1889,7 @@ impl AutoV2 {
             lv.sigma,
             work.sum.as_mut(),
         )?;
-        let Some((root, w8, next)) = deep_space_component(work, plane8) else {
+        let Some((root, w8, next, seeds)) = deep_space_component(work, plane8) else {
             return self
                 .small_target
                 .then(|| self.small_target_stage(frame, work, win, lv, seen))
@@ -1893,7 +1897,6 @@ impl AutoV2 {
         };
         // A component of weakly departing cells alone is no target: a small target may
         // still be there at the pixel scale (stage 2d).
-        let seeds = seeds_of(work, n8, root);
         if seeds.strongest() == 0 {
             return self
                 .small_target
@@ -3159,15 +3162,15 @@ mod tests {
         // The pair (code 48: 8 each) is stronger than the three cells (3), weaker than
         // the band: the three cells.
         setup(&mut work, 48, true);
-        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        let (_, w8, _, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
         assert_eq!(boxed(w8), (30, 10, 32, 10, 3));
         // Without them the weak band stays (the stage then hands over).
         setup(&mut work, 48, false);
-        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        let (_, w8, _, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
         assert_eq!(boxed(w8), (0, 0, 40, 30, 71));
         // A pair stronger than the band (code 112: 128 each) is the strongest: taken.
         setup(&mut work, 112, true);
-        let (_, w8, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
+        let (_, w8, _, _) = deep_space_component(&mut work, (pw, ph)).unwrap();
         assert_eq!(boxed(w8), (20, 20, 21, 20, 2));
     }
 
