@@ -13,7 +13,12 @@
 //! is a face of its own: it departs, either way, at least [`FACE_SHARE_DIV`]⁻¹ of the
 //! peak's magnitude and [`FACE_MIN_SIGMA`] σ, and more than half the strongest
 //! departure of its sign among its 8 neighbours (inside the box) — the half maximum
-//! of its own face (a face colder than the background beside a hot one counts). Across a blurred edge of the optics' 5×5 kernel the pixel
+//! of its own face (a face colder than the background beside a hot one counts).
+//!
+//! **Over deep space** (session 57, [`Background::DeepSpace`]): stage 2c's boxes lie on
+//! a fitted smooth sky with no clutter to keep out, so a face counts from
+//! [`DEEP_SPACE_FACE_MIN_SIGMA`] σ whatever the peak: a close target's faces in shadow
+//! (under ⅓ of its sunlit face) are no longer cut away. Across a blurred edge of the optics' 5×5 kernel the pixel
 //! just outside holds under half of its inward neighbour, so the faces' outline is
 //! cut where a uniform face's half height is, as before.
 
@@ -44,6 +49,30 @@ pub const FACE_SHARE_DIV: u32 = 3;
 /// … and from this many noise σ (a face of a faint target must stand out of the
 /// noise on its own): 3, 4 and 6 σ gave 2.449 alike at 1/4 on family A.
 pub const FACE_MIN_SIGMA: u32 = 4;
+
+/// What lies around the box, which decides from where a weaker face counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Background {
+    /// The Earth, or not known: a face counts from [`FACE_SHARE_DIV`]⁻¹ of the peak and
+    /// [`FACE_MIN_SIGMA`] σ (clutter and the blur's tail stay out).
+    Cluttered,
+    /// Deep space, as stage 2c fitted it (a smooth surface under white noise): there is
+    /// no clutter to keep out, so a face counts from [`DEEP_SPACE_FACE_MIN_SIGMA`] σ
+    /// (with a neighbour as far: no lone hot pixel) whatever the peak (a close target's faces in shadow, under ⅓ of its sunlit
+    /// face's departure).
+    DeepSpace,
+}
+
+/// Over deep space ([`Background::DeepSpace`]) a face counts from this many noise σ
+/// alone, when a neighbour departs as far (a face is more than one pixel: two hot
+/// pixels are no target; session 57). Chosen on family A (seeds 7001–7201, ½
+/// convention; change of the summed mean IoU of famA, paper A, fixtures A and famAF
+/// against the ⅓-of-peak rule, without the neighbour): 3 σ +0.0121, **4 σ +0.0124**,
+/// 6 σ +0.0091 (famAT: +0.0068 / **+0.0067** / +0.0042); with the neighbour +0.0122
+/// (famAT +0.0067), and `famBSE/000420`'s two hot pixels no longer boxed. The same
+/// 4 σ as [`FACE_MIN_SIGMA`]: a pixel of the sky departs that far by chance about 3
+/// times in 10⁵.
+pub const DEEP_SPACE_FACE_MIN_SIGMA: u32 = 4;
 
 /// Background samples: the one-pixel ring around a box of up to [`MAX_SIDE_PX`] per
 /// side, at most `4 · (48 + 1)` = 196 pixels (400 B of stack).
@@ -98,28 +127,38 @@ fn ring_median(frame: &Frame<'_>, roi: Roi) -> Option<u16> {
 }
 
 /// The strongest departure from `bg` of the sign of `d` among pixel (x, y)'s 3 × 3
-/// inside `roi` (its own included): the level of the face it lies on.
-fn face_level(frame: &Frame<'_>, roi: Roi, x: usize, y: usize, d: i32, bg: i32) -> u32 {
+/// inside `roi` (its own included): the level of the face it lies on; and how many of
+/// its neighbours depart that way by at least `face_min` (a face's other pixels).
+fn face_level(
+    frame: &Frame<'_>,
+    roi: Roi,
+    (x, y): (usize, usize),
+    d: i32,
+    bg: i32,
+    face_min: u32,
+) -> (u32, u32) {
     let x_end = (x + 2).min(usize::from(roi.x1)).min(frame.width());
-    let xs = x.saturating_sub(1).max(usize::from(roi.x0))..x_end;
+    let x_start = x.saturating_sub(1).max(usize::from(roi.x0));
     let ys = y.saturating_sub(1).max(usize::from(roi.y0))..(y + 2).min(usize::from(roi.y1));
-    let mut face = 0u32;
+    let (mut face, mut others) = (0u32, 0u32);
     for yy in ys {
-        for &v in frame.row(yy).and_then(|r| r.get(xs.clone())).unwrap_or(&[]) {
+        let row = frame.row(yy).and_then(|r| r.get(x_start..x_end));
+        for (xx, &v) in (x_start..).zip(row.unwrap_or(&[])) {
             let e = i32::from(v) - bg;
             if e.signum() == d.signum() {
                 face = face.max(e.unsigned_abs());
+                others += u32::from((xx, yy) != (x, y) && e.unsigned_abs() >= face_min);
             }
         }
     }
-    face
+    (face, others)
 }
 
 /// `roi` cut to its half maximum and its weaker faces' (see the module): boxes larger than
 /// [`MAX_SIDE_PX`], or whose peak departs less than [`MIN_PEAK_SIGMA`] · `sigma_dn`
 /// from the ring's median, come back unchanged. The result lies inside `roi` and
 /// holds the peak pixel.
-pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32) -> Roi {
+pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Background) -> Roi {
     if roi.x1 <= roi.x0
         || roi.y1 <= roi.y0
         || roi.x1 - roi.x0 > MAX_SIDE_PX
@@ -149,8 +188,12 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32) -> Roi {
     if peak.unsigned_abs() < MIN_PEAK_SIGMA.saturating_mul(sigma_dn.max(1)) {
         return roi;
     }
-    let face_min =
-        (FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1))).max(peak.unsigned_abs() / FACE_SHARE_DIV);
+    let face_min = match background {
+        Background::Cluttered => FACE_MIN_SIGMA
+            .saturating_mul(sigma_dn.max(1))
+            .max(peak.unsigned_abs() / FACE_SHARE_DIV),
+        Background::DeepSpace => DEEP_SPACE_FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1)),
+    };
     let mut cut = Roi::EMPTY;
     let mut found = false;
     for y in rows.clone() {
@@ -162,8 +205,11 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32) -> Roi {
             // Above half the peak (its sign), or at its own face's half maximum
             // (either sign: a cold face beside a hot one; module docs).
             let kept = d.signum() == peak.signum() && 2 * d.abs() > peak.abs()
-                || d.unsigned_abs() >= face_min
-                    && 2 * d.unsigned_abs() > face_level(frame, roi, x0 + i, y, d, bg);
+                || d.unsigned_abs() >= face_min && {
+                    let (level, others) = face_level(frame, roi, (x0 + i, y), d, bg, face_min);
+                    2 * d.unsigned_abs() > level
+                        && (background == Background::Cluttered || others > 0)
+                };
             if kept {
                 let (x, y) = ((x0 + i) as u16, y as u16);
                 if found {
@@ -237,14 +283,17 @@ mod tests {
         let wide = Roi::new(97, 47, 109, 57);
         let px = blurred_rectangle(|dx, dy| AIRY[dy][dx]);
         let frame = Frame::reference(&px).unwrap();
-        assert_eq!(half_max_box(&frame, wide, 10), rect);
+        assert_eq!(half_max_box(&frame, wide, 10, Background::Cluttered), rect);
         let inv: std::vec::Vec<u16> = px.iter().map(|&v| 6000 - v).collect();
         let frame = Frame::reference(&inv).unwrap();
-        assert_eq!(half_max_box(&frame, wide, 10), rect);
+        assert_eq!(half_max_box(&frame, wide, 10, Background::Cluttered), rect);
         // A large box left alone, and a peak under the threshold: unchanged.
         let big = Roi::new(60, 20, 130, 80);
-        assert_eq!(half_max_box(&frame, big, 10), big);
-        assert_eq!(half_max_box(&frame, wide, 4000), wide);
+        assert_eq!(half_max_box(&frame, big, 10, Background::Cluttered), big);
+        assert_eq!(
+            half_max_box(&frame, wide, 4000, Background::Cluttered),
+            wide
+        );
     }
 
     /// Under a blur as wide as a 5 × 5 box (every weight 1/25; far wider than the
@@ -257,7 +306,10 @@ mod tests {
         let px = blurred_rectangle(|_, _| 1.0 / 25.0);
         let frame = Frame::reference(&px).unwrap();
         let wide = Roi::new(97, 47, 109, 57);
-        assert_eq!(half_max_box(&frame, wide, 10), Roi::new(99, 49, 107, 55));
+        assert_eq!(
+            half_max_box(&frame, wide, 10, Background::Cluttered),
+            Roi::new(99, 49, 107, 55)
+        );
     }
 
     /// A sharp target of three 4 × 5 faces side by side over a flat background of
@@ -281,7 +333,7 @@ mod tests {
         let faces = |second, third| {
             let (px, wide) = three_faces(second, third);
             let frame = Frame::reference(&px).unwrap();
-            half_max_box(&frame, wide, sigma)
+            half_max_box(&frame, wide, sigma, Background::Cluttered)
         };
         // A face at 0.4 of the peak (≥ ⅓ and ≥ 4 σ) is kept, beside it a cold face
         // at −0.35 of the peak too: all three faces.
@@ -305,8 +357,74 @@ mod tests {
         }
         let frame = Frame::reference(&px).unwrap();
         let wide = Roi::new(98, 58, 110, 67);
-        assert_eq!(half_max_box(&frame, wide, 10), Roi::new(100, 60, 104, 65));
-        assert_eq!(half_max_box(&frame, wide, 2), Roi::new(100, 60, 108, 65));
+        assert_eq!(
+            half_max_box(&frame, wide, 10, Background::Cluttered),
+            Roi::new(100, 60, 104, 65)
+        );
+        assert_eq!(
+            half_max_box(&frame, wide, 2, Background::Cluttered),
+            Roi::new(100, 60, 108, 65)
+        );
+    }
+
+    /// Over deep space a close target's faces in shadow count whatever the sunlit
+    /// face's peak (`famA/000073`, `000115`: faces at 0.1–0.3 of the peak), from
+    /// [`DEEP_SPACE_FACE_MIN_SIGMA`] σ; a face under it stays out, as noise would.
+    #[test]
+    fn over_deep_space_faces_count_from_the_noise_alone() {
+        let sigma = 10;
+        let faces = |second, third, background| {
+            let (px, wide) = three_faces(second, third);
+            let frame = Frame::reference(&px).unwrap();
+            half_max_box(&frame, wide, sigma, background)
+        };
+        // Faces at 0.3 and 0.2 of the peak: over the Earth the hot face alone (clutter
+        // could be as strong), over deep space all three faces.
+        assert_eq!(
+            faces(1200, 800, Background::Cluttered),
+            Roi::new(100, 60, 104, 65)
+        );
+        assert_eq!(
+            faces(1200, 800, Background::DeepSpace),
+            Roi::new(100, 60, 112, 65)
+        );
+        // A face at 0.05 of the peak (200 DN, 20 σ) counts; the third at 3.5 σ does
+        // not (under 4 σ).
+        assert_eq!(
+            faces(200, 35, Background::DeepSpace),
+            Roi::new(100, 60, 108, 65)
+        );
+        // A face below the ring's level counts the same (either sign, as over the
+        // Earth).
+        assert_eq!(
+            faces(-200, 0, Background::DeepSpace),
+            Roi::new(100, 60, 108, 65)
+        );
+    }
+
+    /// Over deep space a face is more than one pixel: two hot pixels (the real
+    /// camera's signature, `famBSE/000420`: +909 and +198 DN at σ 3 DN over a sky at
+    /// DN 0) are no target and its face; the box is cut to the stronger one (which
+    /// stage 2c then rejects as under 2 px).
+    #[test]
+    fn over_deep_space_a_lone_pixel_is_no_face() {
+        let mut px = std::vec![0u16; FRAME_WIDTH * FRAME_HEIGHT];
+        px[106 * FRAME_WIDTH + 167] = 909;
+        px[100 * FRAME_WIDTH + 174] = 198;
+        let frame = Frame::reference(&px).unwrap();
+        let wide = Roi::new(166, 99, 176, 108);
+        assert_eq!(
+            half_max_box(&frame, wide, 3, Background::DeepSpace),
+            Roi::new(167, 106, 168, 107)
+        );
+        // With a neighbour at 4 σ the weaker pixel is a face's (the neighbour itself,
+        // under half of it, is the face's blur and stays out).
+        px[100 * FRAME_WIDTH + 175] = 12;
+        let frame = Frame::reference(&px).unwrap();
+        assert_eq!(
+            half_max_box(&frame, wide, 3, Background::DeepSpace),
+            Roi::new(167, 100, 175, 107)
+        );
     }
 
     #[test]
@@ -379,7 +497,7 @@ mod tests {
             },
         ] {
             // A flat frame has no peak: the box comes back unchanged.
-            assert_eq!(half_max_box(&frame, roi, 1), roi);
+            assert_eq!(half_max_box(&frame, roi, 1, Background::Cluttered), roi);
         }
     }
 }

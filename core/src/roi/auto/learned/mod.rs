@@ -2291,8 +2291,15 @@ impl AutoV2 {
             }
             body::body_box(frame, win, mean_dn, marks, lv.sigma, r, self.body)
         });
-        // Stage 7: small boxes cut to their half maximum (far targets' blur).
-        let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma));
+        // Stage 7: small boxes cut to their half maximum (far targets' blur); over
+        // deep space a weaker face counts from the noise alone (no clutter to keep
+        // out; session 57).
+        let background = if space {
+            half_max::Background::DeepSpace
+        } else {
+            half_max::Background::Cluttered
+        };
+        let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma, background));
         // Stage 8: a saturated blob cut back by the optics' spread.
         let roi =
             roi.map(|r| saturated::saturated_box(frame, r, u16::from(self.saturated_erode_px)));
