@@ -12,7 +12,9 @@
 //! (`roi::track::Tracker`) keeps the same invariants over three frames and answers the
 //! same after a reset. Parameters out of bounds are an error, never a panic. Stage 4d's
 //! limb test answers any box of any frame the same twice, `true` only for a box on the
-//! frame's border, inside it and at most a quarter of it.
+//! frame's border, inside it and at most a quarter of it; stage 7's half-maximum cut
+//! keeps any box or cuts it to one inside it holding its peak, over the Earth and over
+//! deep space.
 //!
 //! Runs are deterministic (a fixed seed) unless `PROPTEST_RNG_SEED` says otherwise.
 //! Debug builds run `auto-v2` at some 10–20 ms per full frame: the case counts keep
@@ -585,6 +587,79 @@ proptest! {
         if answer {
             prop_assert!(on_border && inside && small, "{r:?} in {w}x{h}");
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(config(256))]
+
+    /// Stage 7's half-maximum cut (`learned::half_max::half_max_box`) on any frame and
+    /// any box, over the Earth and over deep space: no panic, the same answer twice, the
+    /// box unchanged or cut to a box inside it that holds the pixel departing most from
+    /// the ring's median (the ring collected and sorted here, by brute force). The boxes
+    /// lie around the frame's brightest pixel, some beyond the frame; about a third are
+    /// cut.
+    #[test]
+    fn half_max_cuts_inside_the_box_around_its_peak(
+        seed in any::<u64>(),
+        w in 8usize..=FRAME_WIDTH,
+        h in 8usize..=FRAME_HEIGHT,
+        bits in 1u8..=16,
+        before in (0u16..24, 0u16..24),
+        after in (0u16..24, 0u16..24),
+        sigma in 1u32..8,
+        deep_space in any::<bool>(),
+    ) {
+        use tirroi_core::roi::auto::learned::half_max::{Background, half_max_box};
+        let img = frame(seed, w, h, bits);
+        let f = img.frame();
+        // A box around the frame's brightest pixel (its block, or a hot pixel), so
+        // that most boxes are cut.
+        let top = (0..w * h).max_by_key(|&i| img.px[i]).unwrap_or(0);
+        let (mx, my) = ((top % w) as u16, (top / w) as u16);
+        let r = Roi {
+            x0: mx.saturating_sub(before.0),
+            y0: my.saturating_sub(before.1),
+            x1: mx + 1 + after.0,
+            y1: my + 1 + after.1,
+        };
+        let background = if deep_space { Background::DeepSpace } else { Background::Cluttered };
+        let dn = |x: i64, y: i64| i64::from(img.px[y as usize * w + x as usize]);
+        let cut = half_max_box(&f, r, sigma, background);
+        prop_assert_eq!(cut, half_max_box(&f, r, sigma, background));
+        if cut == r {
+            return Ok(());
+        }
+        prop_assert!(
+            cut.x0 >= r.x0 && cut.y0 >= r.y0 && cut.x1 <= r.x1 && cut.y1 <= r.y1
+                && cut.x0 < cut.x1 && cut.y0 < cut.y1,
+            "{cut:?} from {r:?}"
+        );
+        // The ring: the pixels of the frame just around `r`, outside it.
+        let (x0, y0, x1, y1) =
+            (i64::from(r.x0), i64::from(r.y0), i64::from(r.x1), i64::from(r.y1));
+        let mut ring = Vec::new();
+        for y in y0 - 1..=y1 {
+            for x in x0 - 1..=x1 {
+                let inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+                let in_frame = x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h;
+                if !inside && in_frame {
+                    ring.push(dn(x, y));
+                }
+            }
+        }
+        ring.sort_unstable();
+        let bg = ring[ring.len() / 2];
+        let peak = (r.y0..r.y1.min(h as u16))
+            .flat_map(|y| (r.x0..r.x1.min(w as u16)).map(move |x| (x, y)))
+            .map(|(x, y)| (dn(i64::from(x), i64::from(y)) - bg).abs())
+            .max()
+            .unwrap_or(0);
+        let held = (cut.y0..cut.y1).any(|y| {
+            (cut.x0..cut.x1)
+                .any(|x| (dn(i64::from(x), i64::from(y)) - bg).abs() == peak)
+        });
+        prop_assert!(held, "{cut:?} from {r:?}: no pixel of the peak departure {peak}");
     }
 }
 
