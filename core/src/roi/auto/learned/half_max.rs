@@ -14,13 +14,15 @@
 //! peak's magnitude and [`FACE_MIN_SIGMA`] σ, and more than half the strongest
 //! departure of its sign among its 8 neighbours (inside the box) — the half maximum
 //! of its own face (a face colder than the background beside a hot one counts).
+//! Across a blurred edge of the optics' 5×5 kernel the pixel just outside holds under
+//! half of its inward neighbour, so the faces' outline is cut where a uniform face's
+//! half height is, as before.
 //!
 //! **Over deep space** (session 57, [`Background::DeepSpace`]): stage 2c's boxes lie on
 //! a fitted smooth sky with no clutter to keep out, so a face counts from
-//! [`DEEP_SPACE_FACE_MIN_SIGMA`] σ whatever the peak: a close target's faces in shadow
-//! (under ⅓ of its sunlit face) are no longer cut away. Across a blurred edge of the optics' 5×5 kernel the pixel
-//! just outside holds under half of its inward neighbour, so the faces' outline is
-//! cut where a uniform face's half height is, as before.
+//! [`DEEP_SPACE_FACE_MIN_SIGMA`] σ whatever the peak, when one of its neighbours
+//! departs as far (no lone hot pixel): a close target's faces in shadow (under ⅓ of
+//! its sunlit face) are no longer cut away.
 
 use super::order::select_binned;
 use crate::frame::Frame;
@@ -58,8 +60,8 @@ pub enum Background {
     Cluttered,
     /// Deep space, as stage 2c fitted it (a smooth surface under white noise): there is
     /// no clutter to keep out, so a face counts from [`DEEP_SPACE_FACE_MIN_SIGMA`] σ
-    /// (with a neighbour as far: no lone hot pixel) whatever the peak (a close target's faces in shadow, under ⅓ of its sunlit
-    /// face's departure).
+    /// (with a neighbour as far: no lone hot pixel) whatever the peak (a close target's
+    /// faces in shadow, under ⅓ of its sunlit face's departure).
     DeepSpace,
 }
 
