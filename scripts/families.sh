@@ -11,8 +11,11 @@
 #              famAF  scripts/training/realistic-far-radiometry.toml, 600, seed 7201
 #              famAE  scripts/training/realistic-no-target.toml, 300, seed 7101 (no target)
 #              famAT  realistic-tango, 300, seed 7001
+#              paperAT tango (the paper world's Tango), 300, seed 7001 (session 57: the
+#                     paper's Table 8 had no family-A set to choose on)
+#              (famAT and paperAT are reported beside family A's sum, not in it)
 #   held out:  famB   realistic, 600, seed 9001      famBT  realistic-tango, 300, seed 9001
-#              paperB paper, 300, seed 9001
+#              paperB paper, 300, seed 9001          paperBT tango, 300, seed 9001
 #              famBW  realistic-winged, 1 200, seed 9001: a target shape (a small satellite
 #                     with two solar wings) no model was trained or tuned on
 #              ts-fixtures, ts-dark, ts-real-earth: `tirroi testset --kind ...`, 200, seed 16
@@ -69,8 +72,8 @@ else
     fi
 fi
 
-family_a=(famA paperA fixA famAF famAE famAT)
-held_out=(famB famBT paperB famBW ts-fixtures ts-dark ts-real-earth)
+family_a=(famA paperA fixA famAF famAE famAT paperAT)
+held_out=(famB famBT paperB paperBT famBW ts-fixtures ts-dark ts-real-earth)
 
 # "family A" or "held out": the set's role in a choice.
 role_of() {
@@ -130,9 +133,11 @@ case $cmd in
         render_set famAE render --config "$training/realistic-no-target.toml" \
             --count 300 --seed 7101
         render_set famAT render --preset realistic-tango --count 300 --seed 7001 --masks
+        render_set paperAT render --preset tango --count 300 --seed 7001 --masks
         render_set famB render --preset realistic --count 600 --seed 9001 --masks
         render_set famBT render --preset realistic-tango --count 300 --seed 9001 --masks
         render_set paperB render --preset paper --count 300 --seed 9001 --masks
+        render_set paperBT render --preset tango --count 300 --seed 9001 --masks
         render_set famBW render --preset realistic-winged --count 1200 --seed 9001
         for kind in fixtures dark real-earth; do
             render_set "ts-$kind" testset --kind "$kind" --count 200 --seed 16
@@ -193,7 +198,7 @@ case $cmd in
             read -r targets iou fa empty auc gap <<<"$(fields "$out/half/$name/summary.csv" all all)"
             read -r _ quarter _ <<<"$(fields "$out/quarter/$name/summary.csv" all all)"
             if [[ $targets -gt 0 ]]; then
-                if [[ $role == "family A" && $name != famAT ]]; then
+                if [[ $role == "family A" && $name != famAT && $name != paperAT ]]; then
                     sum=$(awk -v a="$sum" -v b="$iou" 'BEGIN { printf "%.4f", a + b }')
                 fi
             else
@@ -231,7 +236,7 @@ case $cmd in
             read -r _ iou_b fa_b _ <<<"$(fields "$out/b/$name/summary.csv" all all)"
             if [[ $targets -gt 0 ]]; then
                 delta=$(awk -v a="$iou_a" -v b="$iou_b" 'BEGIN { printf "%+.4f", b - a }')
-                if [[ $role == "family A" && $name != famAT ]]; then
+                if [[ $role == "family A" && $name != famAT && $name != paperAT ]]; then
                     sum_a=$(awk -v s="$sum_a" -v d="$delta" 'BEGIN { printf "%+.4f", s + d }')
                 elif [[ $role == "held out" ]]; then
                     sum_h=$(awk -v s="$sum_h" -v d="$delta" 'BEGIN { printf "%+.4f", s + d }')

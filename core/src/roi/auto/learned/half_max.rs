@@ -22,7 +22,10 @@
 //! a fitted smooth sky with no clutter to keep out, so a face counts from
 //! [`DEEP_SPACE_FACE_MIN_SIGMA`] σ whatever the peak, when one of its neighbours
 //! departs as far (no lone hot pixel): a close target's faces in shadow (under ⅓ of
-//! its sunlit face) are no longer cut away.
+//! its sunlit face) are no longer cut away. So too for any other stage's box whose ring
+//! is a sky clipped at DN 0 (its median 0 DN: nothing around the box but clipped noise)
+//! and that holds no saturated pixel (whose optics' halo and a limb beside it would
+//! pass for faces).
 
 use super::order::select_binned;
 use crate::frame::Frame;
@@ -56,7 +59,9 @@ pub const FACE_MIN_SIGMA: u32 = 4;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Background {
     /// The Earth, or not known: a face counts from [`FACE_SHARE_DIV`]⁻¹ of the peak and
-    /// [`FACE_MIN_SIGMA`] σ (clutter and the blur's tail stay out).
+    /// [`FACE_MIN_SIGMA`] σ (clutter and the blur's tail stay out). Unless the ring
+    /// around the box is deep space clipped at DN 0 (its median is 0) and the box holds
+    /// no saturated pixel: then as [`Background::DeepSpace`].
     Cluttered,
     /// Deep space, as stage 2c fitted it (a smooth surface under white noise): there is
     /// no clutter to keep out, so a face counts from [`DEEP_SPACE_FACE_MIN_SIGMA`] σ
@@ -156,6 +161,18 @@ fn face_level(
     (face, others)
 }
 
+/// Whether a pixel of `roi` (cut to the frame) is at the frame's top DN.
+fn holds_saturated(frame: &Frame<'_>, roi: Roi) -> bool {
+    let (x0, x1) = (usize::from(roi.x0), usize::from(roi.x1));
+    let max_dn = frame.max_dn();
+    (usize::from(roi.y0)..usize::from(roi.y1).min(frame.height())).any(|y| {
+        frame
+            .row(y)
+            .and_then(|r| r.get(x0..x1.min(r.len())))
+            .is_some_and(|r| r.iter().any(|&v| v >= max_dn))
+    })
+}
+
 /// `roi` cut to its half maximum and its weaker faces' (see the module): boxes larger than
 /// [`MAX_SIDE_PX`], or whose peak departs less than [`MIN_PEAK_SIGMA`] · `sigma_dn`
 /// from the ring's median, come back unchanged. The result lies inside `roi` and
@@ -190,11 +207,17 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
     if peak.unsigned_abs() < MIN_PEAK_SIGMA.saturating_mul(sigma_dn.max(1)) {
         return roi;
     }
-    let face_min = match background {
-        Background::Cluttered => FACE_MIN_SIGMA
+    // A ring at DN 0 is deep space clipped by the camera (see [`Background::Cluttered`]).
+    let deep_space = match background {
+        Background::DeepSpace => true,
+        Background::Cluttered => bg == 0 && !holds_saturated(frame, roi),
+    };
+    let face_min = if deep_space {
+        DEEP_SPACE_FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1))
+    } else {
+        FACE_MIN_SIGMA
             .saturating_mul(sigma_dn.max(1))
-            .max(peak.unsigned_abs() / FACE_SHARE_DIV),
-        Background::DeepSpace => DEEP_SPACE_FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1)),
+            .max(peak.unsigned_abs() / FACE_SHARE_DIV)
     };
     let mut cut = Roi::EMPTY;
     let mut found = false;
@@ -209,8 +232,7 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
             let kept = d.signum() == peak.signum() && 2 * d.abs() > peak.abs()
                 || d.unsigned_abs() >= face_min && {
                     let (level, others) = face_level(frame, roi, (x0 + i, y), d, bg, face_min);
-                    2 * d.unsigned_abs() > level
-                        && (background == Background::Cluttered || others > 0)
+                    2 * d.unsigned_abs() > level && (!deep_space || others > 0)
                 };
             if kept {
                 let (x, y) = ((x0 + i) as u16, y as u16);
@@ -401,6 +423,39 @@ mod tests {
         assert_eq!(
             faces(-200, 0, Background::DeepSpace),
             Roi::new(100, 60, 108, 65)
+        );
+    }
+
+    /// A box of any stage whose ring is a sky clipped at DN 0 (the `paper` world's deep
+    /// space, `paperAT/000186`: a Tango's faces in shadow beside its sunlit face) is cut
+    /// as over deep space; one holding a saturated pixel (a halo, a limb beside it)
+    /// as over the Earth.
+    #[test]
+    fn a_ring_at_dn_0_is_deep_space_unless_the_box_saturates() {
+        let mut px = std::vec![0u16; FRAME_WIDTH * FRAME_HEIGHT];
+        for y in 60..65 {
+            for (x0, dn) in [(100usize, 4000u16), (104, 600), (108, 300)] {
+                for x in x0..x0 + 4 {
+                    px[y * FRAME_WIDTH + x] = dn;
+                }
+            }
+        }
+        let wide = Roi::new(98, 58, 114, 67);
+        let frame = Frame::reference(&px).unwrap();
+        let all = Roi::new(100, 60, 112, 65);
+        assert_eq!(half_max_box(&frame, wide, 10, Background::Cluttered), all);
+        assert_eq!(half_max_box(&frame, wide, 10, Background::DeepSpace), all);
+        // The hot face saturated: over the Earth's rule, the hot face alone.
+        let top = frame.max_dn();
+        for y in 60..65 {
+            for x in 100..104 {
+                px[y * FRAME_WIDTH + x] = top;
+            }
+        }
+        let frame = Frame::reference(&px).unwrap();
+        assert_eq!(
+            half_max_box(&frame, wide, 10, Background::Cluttered),
+            Roi::new(100, 60, 104, 65)
         );
     }
 
