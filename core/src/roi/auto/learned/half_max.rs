@@ -161,18 +161,6 @@ fn face_level(
     (face, others)
 }
 
-/// Whether a pixel of `roi` (cut to the frame) is at the frame's top DN.
-fn holds_saturated(frame: &Frame<'_>, roi: Roi) -> bool {
-    let (x0, x1) = (usize::from(roi.x0), usize::from(roi.x1));
-    let max_dn = frame.max_dn();
-    (usize::from(roi.y0)..usize::from(roi.y1).min(frame.height())).any(|y| {
-        frame
-            .row(y)
-            .and_then(|r| r.get(x0..x1.min(r.len())))
-            .is_some_and(|r| r.iter().any(|&v| v >= max_dn))
-    })
-}
-
 /// `roi` cut to its half maximum and its weaker faces' (see the module): boxes larger than
 /// [`MAX_SIDE_PX`], or whose peak departs less than [`MIN_PEAK_SIGMA`] · `sigma_dn`
 /// from the ring's median, come back unchanged. The result lies inside `roi` and
@@ -191,8 +179,9 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
     let bg = i32::from(bg);
     let (x0, x1) = (usize::from(roi.x0), usize::from(roi.x1));
     let rows = usize::from(roi.y0)..usize::from(roi.y1).min(frame.height());
-    // The peak departure, signed.
-    let mut peak = 0i32;
+    // The peak departure, signed, and whether a pixel is at the top DN (saturated).
+    let (mut peak, mut saturated) = (0i32, false);
+    let max_dn = frame.max_dn();
     for y in rows.clone() {
         let Some(row) = frame.row(y).and_then(|r| r.get(x0..x1)) else {
             continue;
@@ -202,6 +191,7 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
             if d.abs() > peak.abs() {
                 peak = d;
             }
+            saturated |= v >= max_dn;
         }
     }
     if peak.unsigned_abs() < MIN_PEAK_SIGMA.saturating_mul(sigma_dn.max(1)) {
@@ -210,7 +200,7 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
     // A ring at DN 0 is deep space clipped by the camera (see [`Background::Cluttered`]).
     let deep_space = match background {
         Background::DeepSpace => true,
-        Background::Cluttered => bg == 0 && !holds_saturated(frame, roi),
+        Background::Cluttered => bg == 0 && !saturated,
     };
     let face_min = if deep_space {
         DEEP_SPACE_FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1))
