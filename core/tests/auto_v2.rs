@@ -66,7 +66,8 @@ fn params() -> impl Strategy<Value = AutoV2> {
             Just(BlobRule::Always)
         ],
         prior(),
-        any::<bool>(),
+        // (deep_space, sky_beside_earth)
+        (any::<bool>(), any::<bool>()),
         any::<bool>(),
         prop_oneof![Just(3u8), 1u8..=4],
         // (spot, link_cells, look, candidate floor, spots compete below, outline):
@@ -90,7 +91,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                 prescreen,
                 blob,
                 prior,
-                deep_space,
+                (deep_space, sky_beside_earth),
                 small_target,
                 candidates,
                 (
@@ -113,6 +114,7 @@ fn params() -> impl Strategy<Value = AutoV2> {
                     prescreen,
                     blob,
                     deep_space,
+                    sky_beside_earth,
                     small_target,
                     candidates,
                     spot,

@@ -89,6 +89,7 @@ fuzz_target!(|data: &[u8]| {
         },
         prescreen: data[8] & 0x40 == 0,
         deep_space: data[8] & 0x20 == 0,
+        sky_beside_earth: data[1] & 0x01 == 0,
         small_target: data[8] & 0x10 != 0,
         blob: match data[3] / 64 {
             0 => BlobRule::Off,

@@ -27,6 +27,7 @@ mod blob_weights;
 pub mod body;
 mod cells;
 mod confidence_weights;
+pub mod earth_mask;
 pub mod features;
 pub mod forest;
 mod forest_trees;
@@ -130,6 +131,13 @@ pub struct AutoV2 {
     /// the frame has a saturated blob (stage 2b decides then), the classifier decides.
     /// Default on.
     pub deep_space: bool,
+    /// Stage 2e ([`earth_mask`]): where stage 2c finds no deep space and the frame holds
+    /// both the Earth and sky, the sky beside the Earth fitted alone (the Earth's
+    /// cells and [`earth_mask::EXCLUDED_CELLS`] around them left out), its departing
+    /// cells boxed as stage 2c's are, unless their component reaches the Earth's
+    /// margin ([`earth_mask::MARGIN_CELLS`]); such a box carries
+    /// [`SKY_BESIDE_EARTH_SCORE_PERMILLE`]. Default on (with `deep_space`).
+    pub sky_beside_earth: bool,
     /// Stage 2d ([`small`]): where stage 2c takes the window for deep space but no
     /// cell departs as a target's, a small target searched at the pixel scale; its box
     /// carries [`SMALL_TARGET_SCORE_PERMILLE`]. **Default off**: chosen on family A it
@@ -550,6 +558,7 @@ impl AutoV2 {
         prescreen: true,
         blob: BlobRule::Compete,
         deep_space: true,
+        sky_beside_earth: true,
         small_target: false,
         candidates: 3,
         spot: true,
@@ -1017,6 +1026,82 @@ fn deep_space_component<C: FrameCapacity>(
 /// 0.4878, famAF +0.0012, famA +0.0006; no set lower, no false alarm added), 4 →
 /// +0.0106.
 pub const DEEP_SPACE_FALLBACK_MIN_CELLS: usize = 3;
+
+/// What stages 2c and 2e make of a component of departing cells.
+enum Departure {
+    /// The target's box (or [`NO_TARGET`] under the gate).
+    Boxed(Detection),
+    /// Not a target over the sky (the Earth's, by its geometry or sign): the
+    /// classifier decides.
+    Classifier,
+    /// No box of [`MIN_BOX_SIDE_PX`] (a cell's noise, a hot pixel): stage 2d may look
+    /// at the pixel scale.
+    NoBox,
+}
+
+/// Fewest cells of stage 2e's component: one departing cell beside the Earth is the
+/// fitted sky's noise or a hot pixel as often as a target (the Python replay of
+/// session 57 took components of 2 cells and more).
+pub const SKY_MIN_CELLS: u16 = 2;
+
+/// Confidence of a box of stage 2e (the sky beside the Earth), ‰: its hit rate
+/// (IoU ≥ ½) on family A (session 58, seeds 7001–7201): 26 of 31 (famA 4 of 5, famAT
+/// 3 of 4, famAF 1 of 4: far targets boxed in part, fixtures A 18 of 18; none on a
+/// frame without a target).
+pub const SKY_BESIDE_EARTH_SCORE_PERMILLE: u16 = 839;
+
+/// Stage 2e's component: labelled as stage 2c's ([`strongest_component`]), the
+/// strongest (summed code) of those holding a seed, of at least [`SKY_MIN_CELLS`]
+/// cells, none of them at [`earth_mask::MARGIN_CELLS`] of the Earth (`dilated4`
+/// holds the cells' distances to it), with its [`Seeds`]; `None` without one.
+fn sky_component<C: FrameCapacity>(
+    work: &mut AutoV2Work<C>,
+    plane8: (usize, usize),
+) -> Option<(u8, CellStats, usize, Seeds)> {
+    let n8 = plane8.0 * plane8.1;
+    // Nothing the camera sees is colder than deep space: only cells departing upwards
+    // from the fitted sky are a target's (`sum` holds the residuals, `f32` bits).
+    for (code, &r) in work
+        .labels4
+        .as_mut()
+        .iter_mut()
+        .zip(work.sum.as_ref())
+        .take(n8)
+    {
+        if f32::from_bits(r).is_nan() || f32::from_bits(r) <= 0.0 {
+            *code = 0;
+        }
+    }
+    let (_, _, next) = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
+    // Per root (labels are `u8`): bit 0 seeded, bit 1 at the Earth's margin.
+    const SEEDED: u8 = 1;
+    const AT_MARGIN: u8 = 2;
+    let mut flags = [0u8; 256];
+    let cells = work.labels8.as_ref().get(..n8)?.iter();
+    for ((&l, &code), &d) in cells.zip(work.labels4.as_ref()).zip(work.dilated4.as_ref()) {
+        if l == 0 {
+            continue;
+        }
+        if let Some(f) = flags.get_mut(usize::from(work.comps.find(l))) {
+            *f |= (u8::from(code > smooth::WEAK_CODE) * SEEDED)
+                | (u8::from(d <= earth_mask::MARGIN_CELLS) * AT_MARGIN);
+        }
+    }
+    let mut best: Option<(u8, CellStats)> = None;
+    for (l, &f) in flags.iter().enumerate().take(next).skip(1) {
+        if f != SEEDED || work.comps.parents().get(l) != Some(&(l as u8)) {
+            continue;
+        }
+        let Some(c) = work.comps.stats(l) else {
+            continue;
+        };
+        if c.area >= SKY_MIN_CELLS && best.is_none_or(|(_, b)| c.energy > b.energy) {
+            best = Some((l as u8, *c));
+        }
+    }
+    let (root, w8) = best?;
+    Some((root, w8, next, seeds_of(work, n8, root)))
+}
 
 /// Largest [`AutoV2::link_cells`], cells.
 pub const MAX_LINK_CELLS: usize = 3;
@@ -1882,27 +1967,140 @@ impl AutoV2 {
             .min(work.mean_dn.as_ref().len());
         // `labels4` holds the cells' saturated counts (stage 1) and takes the codes.
         // `sum` (the integrals', filled after this stage) holds the residuals.
-        let seen = smooth::deep_space_codes(
+        let Some(seen) = smooth::deep_space_codes(
             &work.mean_dn.as_ref()[..n8],
             &mut work.labels4.as_mut()[..n8],
             plane8,
             lv.sigma,
             work.sum.as_mut(),
-        )?;
+        ) else {
+            return if self.sky_beside_earth {
+                self.sky_beside_earth_stage(frame, work, win, plane8, lv)
+            } else {
+                None
+            };
+        };
+        let small_target = |this: &Self, work: &mut AutoV2Work<C>| {
+            this.small_target
+                .then(|| this.small_target_stage(frame, work, win, lv, seen))
+                .flatten()
+        };
         let Some((root, w8, next, seeds)) = deep_space_component(work, plane8) else {
-            return self
-                .small_target
-                .then(|| self.small_target_stage(frame, work, win, lv, seen))
-                .flatten();
+            return small_target(self, work);
         };
         // A component of weakly departing cells alone is no target: a small target may
         // still be there at the pixel scale (stage 2d).
         if seeds.strongest() == 0 {
-            return self
-                .small_target
-                .then(|| self.small_target_stage(frame, work, win, lv, seen))
-                .flatten();
+            return small_target(self, work);
         }
+        let scores = (DEEP_SPACE_SCORE_PERMILLE, BORDER_PIECE_SCORE_PERMILLE);
+        match self.box_departure(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            (root, w8, next),
+            seeds,
+            scores,
+        ) {
+            Departure::Boxed(d) => {
+                work.deep_space = Some(seen);
+                Some(d)
+            }
+            // The surface was fitted to the Earth in part (its component departs
+            // downwards) or the component is the Earth's (the limb, its disc in a
+            // corner): the sky beside the Earth, fitted alone, may still hold a target.
+            Departure::Classifier if self.sky_beside_earth => {
+                // Stage 2c's codes took the saturated counts' plane.
+                blob::saturated_counts(frame, win, work.labels4.as_mut());
+                self.sky_beside_earth_stage(frame, work, win, plane8, lv)
+            }
+            Departure::Classifier => None,
+            Departure::NoBox => small_target(self, work),
+        }
+    }
+
+    /// Stage 2e ([`earth_mask`], [`AutoV2::sky_beside_earth`]): where the window holds
+    /// the Earth and enough sky beside it, the sky alone is fitted as stage 2c fits the
+    /// window, and its strongest seeded component of at least [`SKY_MIN_CELLS`] cells
+    /// that does not reach the Earth's margin is boxed as stage 2c's is
+    /// ([`AutoV2::box_departure`]), with [`SKY_BESIDE_EARTH_SCORE_PERMILLE`]; `None`
+    /// (the classifier decides) otherwise.
+    #[inline(never)]
+    fn sky_beside_earth_stage<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+    ) -> Option<Detection> {
+        let n8 = (plane8.0 * plane8.1)
+            .min(work.labels4.as_ref().len())
+            .min(work.labels8.as_ref().len())
+            .min(work.mean_dn.as_ref().len())
+            .min(work.dilated4.as_ref().len());
+        // `dilated4` takes the cells' distances to the Earth and `sum_sq` the floods'
+        // stack (both free until stage 3); `sum` the residuals, as in stage 2c.
+        earth_mask::earth_distance(
+            &work.mean_dn.as_ref()[..n8],
+            plane8,
+            &mut work.dilated4.as_mut()[..n8],
+            work.sum_sq.as_mut(),
+        )?;
+        let distance = &work.dilated4.as_ref()[..n8];
+        let seen = smooth::sky_codes(
+            &work.mean_dn.as_ref()[..n8],
+            &mut work.labels4.as_mut()[..n8],
+            plane8,
+            lv.sigma,
+            work.sum.as_mut(),
+            |i| {
+                distance
+                    .get(i)
+                    .is_some_and(|&d| d > earth_mask::EXCLUDED_CELLS)
+            },
+            earth_mask::MIN_SKY_PERMILLE,
+        )?;
+        let (root, w8, next, seeds) = sky_component(work, plane8)?;
+        let scores = (
+            SKY_BESIDE_EARTH_SCORE_PERMILLE,
+            SKY_BESIDE_EARTH_SCORE_PERMILLE,
+        );
+        match self.box_departure(
+            frame,
+            work,
+            win,
+            plane8,
+            lv,
+            (root, w8, next),
+            seeds,
+            scores,
+        ) {
+            Departure::Boxed(d) => {
+                work.deep_space = Some(seen);
+                Some(d)
+            }
+            Departure::Classifier | Departure::NoBox => None,
+        }
+    }
+
+    /// Stages 2c and 2e: the seeded component `(root, w8, next)` of departing cells
+    /// (their [`Seeds`]) refined and judged as a target over the fitted sky; its box
+    /// carries `scores.0`, or `scores.1` when cut by the window's border.
+    #[allow(clippy::too_many_arguments)]
+    fn box_departure<C: FrameCapacity>(
+        &self,
+        frame: &Frame<'_>,
+        work: &mut AutoV2Work<C>,
+        win: Window,
+        plane8: (usize, usize),
+        lv: FrameLevels,
+        (root, w8, next): (u8, CellStats, usize),
+        seeds: Seeds,
+        (interior_permille, border_permille): (u16, u16),
+    ) -> Departure {
         // A component on the window's border may be the Earth's disc in a corner (the
         // rest of the frame deep space): the classifier, trained on such frames,
         // decides, unless the geometry rules the disc out (a target cut by one side,
@@ -1918,7 +2116,7 @@ impl AutoV2 {
         // classifier), famAT 0.3739 → 0.3769, false alarms famAE 19 → 10 of 300,
         // famASE 27 → 15 of 480, famAT 4 → 1, famAF 4 → 3; no set lower.
         if seeds.up <= seeds.down {
-            return None;
+            return Departure::Classifier;
         }
         let border = w8.sides_touched(plane8) > 0;
         // A component in a corner is the stage's when its outline bends (tested after
@@ -1930,12 +2128,12 @@ impl AutoV2 {
                 && seeds.upwards()
                 && seeds.strongest() >= BORDER_PIECE_MIN_CODE)
         {
-            return None;
+            return Departure::Classifier;
         }
         let score_permille = if border {
-            BORDER_PIECE_SCORE_PERMILLE
+            border_permille
         } else {
-            DEEP_SPACE_SCORE_PERMILLE
+            interior_permille
         };
         let d = self.finish(
             frame,
@@ -1964,26 +2162,19 @@ impl AutoV2 {
             }
         };
         if limb_piece {
-            return None;
+            return Departure::Classifier;
         }
         // A box one pixel across is a hot pixel (the real camera's signature): no
         // target is imaged on fewer than 2 px across (the `realistic` world's
         // smallest far target: 3 px).
         let Some(r) = d.roi else {
-            return self
-                .small_target
-                .then(|| self.small_target_stage(frame, work, win, lv, seen))
-                .flatten();
+            return Departure::NoBox;
         };
         if r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX {
             // A hot pixel's cell: a small target may still be there (stage 2d).
-            return self
-                .small_target
-                .then(|| self.small_target_stage(frame, work, win, lv, seen))
-                .flatten();
+            return Departure::NoBox;
         }
-        work.deep_space = Some(seen);
-        Some(if score_permille < self.min_score_permille {
+        Departure::Boxed(if score_permille < self.min_score_permille {
             NO_TARGET
         } else {
             d
@@ -2318,7 +2509,8 @@ impl core::fmt::Display for AutoV2 {
             f,
             "fine_sigma={} cell_score={} min_score_permille={} saturated_erode_px={} \
              body_k_sigma={} body_ring_cells={}..={} body_max_share_permille={} \
-             body_trim_permille={} prescreen={} blob={:?} deep_space={} small_target={} \
+             body_trim_permille={} prescreen={} blob={:?} deep_space={} sky_beside_earth={} \
+             small_target={} \
              candidates={} spot={} spot_competes_below_permille={}",
             self.fine_sigma,
             self.cell_score,
@@ -2332,6 +2524,7 @@ impl core::fmt::Display for AutoV2 {
             self.prescreen,
             self.blob,
             self.deep_space,
+            self.sky_beside_earth,
             self.small_target,
             self.candidates,
             self.spot,
@@ -2906,6 +3099,62 @@ mod tests {
         let frame = Frame::reference(&px).unwrap();
         off.detect(&frame, &mut scratch).unwrap();
         assert!(scratch.work().deep_space().is_none());
+    }
+
+    /// The shaded sky of [`shaded_sky`] beside the Earth: a disc of radius 760 px
+    /// centred at (700, 700) px, beyond the lower right corner, 1 500 DN above the sky
+    /// with colder clouds (−400 DN) in a pattern the cells see as texture; optionally a
+    /// target 60 DN above the sky at 40..80 × 30..60.
+    fn earth_beside_sky(target: bool) -> std::vec::Vec<u16> {
+        let mut px = shaded_sky(false, false);
+        for (i, v) in px.iter_mut().enumerate() {
+            let (x, y) = ((i % FRAME_WIDTH) as f32, (i / FRAME_WIDTH) as f32);
+            let (dx, dy) = (x - 700.0, y - 700.0);
+            if dx * dx + dy * dy <= 760.0 * 760.0 {
+                let cloud = libm::sinf(x * 0.13) * libm::cosf(y * 0.11) > 0.4;
+                *v += if cloud { 1100 } else { 1500 };
+            }
+            if target && (40.0..80.0).contains(&x) && (30.0..60.0).contains(&y) {
+                *v += 60;
+            }
+        }
+        px
+    }
+
+    /// Stage 2e: beside a textured Earth (no smooth surface fits the window: stage 2c
+    /// finds no deep space) the sky alone is fitted and the target over it boxed with
+    /// the stage's confidence, the same twice; without a target, or with the stage
+    /// off, the stage gives no box.
+    #[test]
+    fn a_target_over_the_sky_beside_the_earth_is_found_by_stage_2e() {
+        let det = AutoV2::default();
+        let mut scratch = std::boxed::Box::new(AutoV2Scratch::new());
+        let px = earth_beside_sky(true);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_some(), "{d:?}");
+        assert_eq!(d.score_permille, SKY_BESIDE_EARTH_SCORE_PERMILLE, "{d:?}");
+        let r = d.roi.expect("the target's box");
+        assert!(r.iou(&Roi::new(40, 30, 80, 60)) > 0.9, "{r:?}");
+        assert_eq!(
+            d,
+            det.detect(&frame, &mut scratch).unwrap(),
+            "same answer twice"
+        );
+        // Without the target: not the stage's box.
+        let px = earth_beside_sky(false);
+        let frame = Frame::reference(&px).unwrap();
+        let d = det.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_none(), "{d:?}");
+        // The stage off: not its box.
+        let off = AutoV2 {
+            sky_beside_earth: false,
+            ..det
+        };
+        let px = earth_beside_sky(true);
+        let frame = Frame::reference(&px).unwrap();
+        let d = off.detect(&frame, &mut scratch).unwrap();
+        assert!(scratch.work().deep_space().is_none(), "{d:?}");
     }
 
     /// The shaded sky of [`shaded_sky`] (with its hot pixel) and a face `dn` DN off the

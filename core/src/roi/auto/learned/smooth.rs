@@ -222,9 +222,52 @@ pub struct DeepSpace {
 pub fn deep_space_codes(
     mean_dn: &[u16],
     saturated_then_codes: &mut [u8],
+    plane: (usize, usize),
+    sigma_dn: u32,
+    scratch: &mut [u32],
+) -> Option<DeepSpace> {
+    fit_codes(
+        mean_dn,
+        saturated_then_codes,
+        plane,
+        sigma_dn,
+        scratch,
+        (|_| true, MIN_VALID_PERMILLE),
+    )
+}
+
+/// Stage 2e: [`deep_space_codes`] on the cells `sky` takes (the sky beside the Earth:
+/// its other cells are left out of the fit and coded 0, as unusable ones are), of
+/// which at least `min_sky_permille` of the plane's cells must be usable.
+pub fn sky_codes(
+    mean_dn: &[u16],
+    saturated_then_codes: &mut [u8],
+    plane: (usize, usize),
+    sigma_dn: u32,
+    scratch: &mut [u32],
+    sky: impl Fn(usize) -> bool,
+    min_sky_permille: usize,
+) -> Option<DeepSpace> {
+    fit_codes(
+        mean_dn,
+        saturated_then_codes,
+        plane,
+        sigma_dn,
+        scratch,
+        (sky, min_sky_permille),
+    )
+}
+
+/// [`deep_space_codes`] on the cells `fitted.0` takes, at least `fitted.1` ‰ of the
+/// plane's cells usable.
+#[inline(always)]
+fn fit_codes(
+    mean_dn: &[u16],
+    saturated_then_codes: &mut [u8],
     (pw, ph): (usize, usize),
     sigma_dn: u32,
     scratch: &mut [u32],
+    (fitted, min_valid_permille): (impl Fn(usize) -> bool, usize),
 ) -> Option<DeepSpace> {
     let n = pw * ph;
     let mean_dn = mean_dn.get(..n)?;
@@ -235,13 +278,14 @@ pub fn deep_space_codes(
     }
     let saturated_px: &[u8] = plane_codes;
     let usable_at = |i: usize| {
-        usable(
-            mean_dn.get(i).copied().unwrap_or(0),
-            saturated_px.get(i).copied().unwrap_or(1),
-        )
+        fitted(i)
+            && usable(
+                mean_dn.get(i).copied().unwrap_or(0),
+                saturated_px.get(i).copied().unwrap_or(1),
+            )
     };
     let valid = (0..n).filter(|&i| usable_at(i)).count();
-    if valid * 1000 < MIN_VALID_PERMILLE * n {
+    if valid * 1000 < min_valid_permille * n {
         return None;
     }
     // Residuals around the frame's median level keep the sums small in `f32`.

@@ -1,0 +1,436 @@
+//! Stage 2e's model of a frame that holds both the Earth and deep space: which cells
+//! are the Earth's, so that the sky beside it can be fitted alone (stage 2c fits one
+//! smooth surface to the whole window, which a frame holding both cannot be).
+//!
+//! The cells' means are split at their Otsu level; the warm side's 8-connected
+//! components of at least [`EARTH_MIN_PERMILLE`] of the cells are the Earth (a target
+//! is smaller; the disc or its limb band is larger), its holes filled (the disc's cold
+//! clouds are no sky: a hole is a region of the cold side the frame's border cannot
+//! reach, 4-connected). Each cell then gets its Chebyshev distance to the Earth, in
+//! cells ([`earth_distance`]): the caller fits the sky on cells beyond
+//! [`EXCLUDED_CELLS`] (the limb's blur and the disc's dark edge stay out of the fit)
+//! and rejects a component that reaches the first cell beyond them (the limb's own
+//! cold fragments; `docs/detectors.md` § Session 57: without that, 10 of famAE's 59
+//! mixed frames without a target were boxed on the limb, with it 1).
+//!
+//! Chosen by a Python replay on family A (session 57, seeds 7001–7201): the share,
+//! the exclusion and the margin. Memory: the distances in a `u8` cell plane and a
+//! work stack of one `u32` per cell, both lent by the caller (`auto-v2`'s planes, free
+//! at this stage); on the stack a 64-bin histogram (256 B). Cost: a pass for the
+//! levels, one for the histogram, ≤ 2 flood fills of the warm side and one of the
+//! cold side (each cell pushed once per fill), two raster passes for the distances.
+
+/// A warm component of at least this share of the cells, ‰, is the Earth (the
+/// `realistic` world's close targets cover at most 5 % of the cells; a limb band
+/// across a 640×512 frame two cells deep is 5 %, one that matters for the fit more).
+pub const EARTH_MIN_PERMILLE: usize = 80;
+
+/// Cells within this Chebyshev distance of the Earth are left out of the sky's fit
+/// (the limb's blur over 2 cells, 16 px, at the `realistic` world's optics).
+pub const EXCLUDED_CELLS: u8 = 2;
+
+/// A component of departing cells with a cell at this distance of the Earth (the first
+/// cell beyond [`EXCLUDED_CELLS`]) is the limb's, not a target's.
+pub const MARGIN_CELLS: u8 = EXCLUDED_CELLS + 1;
+
+/// The sky (cells beyond [`EXCLUDED_CELLS`]) must be at least this share of the
+/// cells, ‰, for the fit to mean anything (a surface of 15 terms on fewer than a fifth
+/// of the frame's blocks extrapolates).
+pub const MIN_SKY_PERMILLE: usize = 200;
+
+/// At most this share of the rows and columns crossing the Earth's cells, ‰, may
+/// cross them in more than one run ([`convex`]). Chosen on family A (session 58, a
+/// Python replay on the frames where stage 2e boxed): frames holding the Earth and sky
+/// split 0–8 % of their lines (the limb's clouds near the split level), but two of 15
+/// at 59 and 79 % (boxes at IoU 0.54 and 0.33); Earth-filled frames split 14–89 %
+/// (seven false or missed boxes of ten).
+pub const MAX_SPLIT_LINES_PERMILLE: usize = 100;
+
+/// Bins of the cell means' histogram for the Otsu split (the split need not be exact:
+/// the Earth's components are far larger than a bin's error).
+const BINS: usize = 64;
+
+/// Cell marks while the Earth is found (before they become distances).
+const COLD: u8 = 0;
+const WARM: u8 = 1;
+const WARM_SEEN: u8 = 2;
+const EARTH: u8 = 3;
+const SKY_SIDE: u8 = 4;
+
+/// Distance of a cell beyond every reachable one (no Earth in the frame).
+const FAR: u8 = u8::MAX;
+
+/// The Otsu level of the cell means (`lo..=hi`): the last bin of the cold side, as a
+/// DN (cells above it are warm); `None` when every mean is equal.
+fn otsu_level(mean_dn: &[u16]) -> Option<(u16, usize)> {
+    let lo = mean_dn.iter().copied().min()?;
+    let hi = mean_dn.iter().copied().max()?;
+    if hi <= lo {
+        return None;
+    }
+    let span = u32::from(hi - lo) + 1;
+    let bin = |m: u16| (u32::from(m - lo) * BINS as u32 / span) as usize;
+    let mut hist = [0u32; BINS];
+    for &m in mean_dn {
+        if let Some(h) = hist.get_mut(bin(m)) {
+            *h += 1;
+        }
+    }
+    let n = mean_dn.len() as f32;
+    let total: f32 = hist
+        .iter()
+        .enumerate()
+        .map(|(b, &c)| b as f32 * c as f32)
+        .sum();
+    let (mut w0, mut s0) = (0.0f32, 0.0f32);
+    let mut best = (f32::MIN, 0usize, 0usize);
+    for (b, &c) in hist.iter().enumerate().take(BINS - 1) {
+        w0 += c as f32;
+        s0 += b as f32 * c as f32;
+        let w1 = n - w0;
+        if w0 == 0.0 || w1 == 0.0 {
+            continue;
+        }
+        let d = s0 / w0 - (total - s0) / w1;
+        let between = w0 * w1 * d * d;
+        if between > best.0 {
+            best = (between, b, w0 as usize);
+        }
+    }
+    // The bin's upper edge: `m` is cold when `bin(m) <= b`.
+    let level = u32::from(lo) + ((best.1 as u32 + 1) * span).div_ceil(BINS as u32) - 1;
+    Some((level.min(u32::from(u16::MAX)) as u16, best.2))
+}
+
+/// Floods from `seed` over cells marked `from` (8-connected when `diagonal`, else
+/// 4-connected), marking them `to`; the cells reached, counting the seed (marked by
+/// the caller). `stack` holds ≥ one entry per cell (each is pushed once).
+fn flood(
+    marks: &mut [u8],
+    (pw, ph): (usize, usize),
+    seed: usize,
+    (from, to): (u8, u8),
+    diagonal: bool,
+    stack: &mut [u32],
+) -> usize {
+    let (mut top, mut reached) = (0usize, 1usize);
+    if let Some(s) = stack.get_mut(top) {
+        *s = seed as u32;
+        top += 1;
+    }
+    while top > 0 {
+        top -= 1;
+        let i = stack.get(top).copied().unwrap_or(0) as usize;
+        let (cx, cy) = (i % pw.max(1), i / pw.max(1));
+        for (dx, dy) in [
+            (-1, 0),
+            (1, 0),
+            (0, -1),
+            (0, 1),
+            (-1, -1),
+            (1, -1),
+            (-1, 1),
+            (1, 1),
+        ]
+        .into_iter()
+        .take(if diagonal { 8 } else { 4 })
+        {
+            let (x, y) = (cx as isize + dx, cy as isize + dy);
+            if x < 0 || y < 0 || x as usize >= pw || y as usize >= ph {
+                continue;
+            }
+            let j = y as usize * pw + x as usize;
+            if marks.get(j) != Some(&from) {
+                continue;
+            }
+            if let (Some(m), Some(s)) = (marks.get_mut(j), stack.get_mut(top)) {
+                *m = to;
+                *s = j as u32;
+                top += 1;
+                reached += 1;
+            }
+        }
+    }
+    reached
+}
+
+/// Whether the Earth's cells (0 in `marks`, the sky's [`FAR`]) cross every row and
+/// column in one run, but for [`MAX_SPLIT_LINES_PERMILLE`] of the lines that cross them:
+/// the disc seen through the frame is convex, while an Earth-filled frame's cold
+/// clouds, taken for sky, cut its warm side into runs.
+fn convex(marks: &[u8], (pw, ph): (usize, usize)) -> bool {
+    // Per line: whether it crosses the Earth, and whether in more than one run.
+    let line = |cells: &mut dyn Iterator<Item = u8>| {
+        let (mut runs, mut inside) = (0u32, false);
+        for m in cells {
+            let earth = m == 0;
+            runs += u32::from(earth && !inside);
+            inside = earth;
+        }
+        (runs > 0, runs > 1)
+    };
+    let (mut crossing, mut split) = (0usize, 0usize);
+    for cy in 0..ph {
+        let (c, s) = line(&mut marks.iter().skip(cy * pw).take(pw).copied());
+        crossing += usize::from(c);
+        split += usize::from(s);
+    }
+    for cx in 0..pw {
+        let (c, s) = line(&mut marks.iter().skip(cx).step_by(pw.max(1)).take(ph).copied());
+        crossing += usize::from(c);
+        split += usize::from(s);
+    }
+    split * 1000 <= MAX_SPLIT_LINES_PERMILLE * crossing
+}
+
+/// Stage 2e's Earth: writes into `distance` (one per cell of the `(pw, ph)` plane of
+/// `mean_dn`) each cell's Chebyshev distance to the Earth in cells (0: the Earth,
+/// saturating at 255), and returns the cells beyond [`EXCLUDED_CELLS`] (the sky to
+/// fit); `None` when the frame holds no Earth component, or too little sky
+/// ([`MIN_SKY_PERMILLE`]), or a slice is shorter than the plane (`stack`: ≥ one
+/// entry per cell).
+pub fn earth_distance(
+    mean_dn: &[u16],
+    (pw, ph): (usize, usize),
+    distance: &mut [u8],
+    stack: &mut [u32],
+) -> Option<usize> {
+    let n = pw * ph;
+    let mean_dn = mean_dn.get(..n)?;
+    let marks = distance.get_mut(..n)?;
+    let stack = stack.get_mut(..n)?;
+    let (level, cold) = otsu_level(mean_dn)?;
+    // The sky lies on the cold side: too few cold cells, no sky to fit.
+    if cold * 1000 < MIN_SKY_PERMILLE * n {
+        return None;
+    }
+    for (m, &v) in marks.iter_mut().zip(mean_dn) {
+        *m = if v > level { WARM } else { COLD };
+    }
+    // The warm side's large components are the Earth.
+    let min_cells = (EARTH_MIN_PERMILLE * n).div_ceil(1000).max(1);
+    let mut earth = false;
+    for i in 0..n {
+        if marks.get(i) != Some(&WARM) {
+            continue;
+        }
+        if let Some(m) = marks.get_mut(i) {
+            *m = WARM_SEEN;
+        }
+        if flood(marks, (pw, ph), i, (WARM, WARM_SEEN), true, stack) >= min_cells {
+            if let Some(m) = marks.get_mut(i) {
+                *m = EARTH;
+            }
+            flood(marks, (pw, ph), i, (WARM_SEEN, EARTH), true, stack);
+            earth = true;
+        }
+    }
+    if !earth {
+        return None;
+    }
+    // The sky side: what the border reaches without crossing the Earth (4-connected,
+    // as the Earth is 8-connected); the rest are the Earth's holes.
+    for m in marks.iter_mut() {
+        if *m != EARTH {
+            *m = COLD;
+        }
+    }
+    for i in 0..n {
+        let (cx, cy) = (i % pw, i / pw);
+        let on_border = cx == 0 || cy == 0 || cx + 1 == pw || cy + 1 == ph;
+        if on_border && marks.get(i) == Some(&COLD) {
+            if let Some(m) = marks.get_mut(i) {
+                *m = SKY_SIDE;
+            }
+            flood(marks, (pw, ph), i, (COLD, SKY_SIDE), false, stack);
+        }
+    }
+    for m in marks.iter_mut() {
+        *m = if *m == SKY_SIDE { FAR } else { 0 };
+    }
+    if !convex(marks, (pw, ph)) {
+        return None;
+    }
+    // Chebyshev distances by two raster passes (every step costs 1).
+    let at = |marks: &[u8], x: isize, y: isize| {
+        if x < 0 || y < 0 || x as usize >= pw || y as usize >= ph {
+            FAR
+        } else {
+            marks
+                .get(y as usize * pw + x as usize)
+                .copied()
+                .unwrap_or(FAR)
+        }
+    };
+    for i in 0..n {
+        let (x, y) = ((i % pw) as isize, (i / pw) as isize);
+        let d = [(-1, 0), (-1, -1), (0, -1), (1, -1)]
+            .iter()
+            .map(|&(dx, dy)| at(marks, x + dx, y + dy).saturating_add(1))
+            .min()
+            .unwrap_or(FAR);
+        if let Some(m) = marks.get_mut(i) {
+            *m = (*m).min(d);
+        }
+    }
+    for i in (0..n).rev() {
+        let (x, y) = ((i % pw) as isize, (i / pw) as isize);
+        let d = [(1, 0), (1, 1), (0, 1), (-1, 1)]
+            .iter()
+            .map(|&(dx, dy)| at(marks, x + dx, y + dy).saturating_add(1))
+            .min()
+            .unwrap_or(FAR);
+        if let Some(m) = marks.get_mut(i) {
+            *m = (*m).min(d);
+        }
+    }
+    let sky = marks.iter().filter(|&&d| d > EXCLUDED_CELLS).count();
+    (sky * 1000 >= MIN_SKY_PERMILLE * n).then_some(sky)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    const PW: usize = 40;
+    const PH: usize = 32;
+
+    /// Whether cell `(x, y)` lies in the disc of radius 60 cells centred at
+    /// (75, 60): the Earth in the plane's lower right.
+    fn in_disc(x: usize, y: usize) -> bool {
+        let (dx, dy) = (x as f32 + 0.5 - 75.0, y as f32 + 0.5 - 60.0);
+        dx * dx + dy * dy <= 60.0 * 60.0
+    }
+
+    /// A cell plane: sky at 1 000 DN with a ±1 DN ripple; the disc at 1 400 DN with a
+    /// cold cloud (1 010 DN, a hole inside it) at cells 33..37 × 25..28; optionally a
+    /// small warm target (1 200 DN) at 5..8 × 5..7.
+    fn plane(target: bool) -> Vec<u16> {
+        (0..PW * PH)
+            .map(|i| {
+                let (x, y) = (i % PW, i / PW);
+                if (33..37).contains(&x) && (25..28).contains(&y) {
+                    1010
+                } else if in_disc(x, y) {
+                    1400
+                } else if target && (5..8).contains(&x) && (5..7).contains(&y) {
+                    1200
+                } else {
+                    1000 + (x + y) as u16 % 2
+                }
+            })
+            .collect()
+    }
+
+    /// The distances are the Chebyshev distances to the disc with its hole filled,
+    /// by brute force; the target is no Earth (too small) and keeps its distance.
+    #[test]
+    fn distances_to_the_filled_disc() {
+        for target in [false, true] {
+            let mean = plane(target);
+            let mut dist = std::vec![7u8; PW * PH];
+            let mut stack = std::vec![0u32; PW * PH];
+            let sky = earth_distance(&mean, (PW, PH), &mut dist, &mut stack).expect("earth");
+            let mut want_sky = 0;
+            for y in 0..PH {
+                for x in 0..PW {
+                    let hole = (33..37).contains(&x) && (25..28).contains(&y);
+                    let want = if in_disc(x, y) || hole {
+                        0
+                    } else {
+                        (0..PH)
+                            .flat_map(|v| (0..PW).map(move |u| (u, v)))
+                            .filter(|&(u, v)| in_disc(u, v))
+                            .map(|(u, v)| x.abs_diff(u).max(y.abs_diff(v)))
+                            .min()
+                            .map_or(255, |d| d.min(255) as u8)
+                    };
+                    assert_eq!(dist[y * PW + x], want, "cell ({x}, {y}), target {target}");
+                    want_sky += usize::from(want > EXCLUDED_CELLS);
+                }
+            }
+            assert_eq!(sky, want_sky);
+        }
+    }
+
+    /// No Earth (a sky with a small target), an Earth-filled plane whose cold clouds
+    /// cross it (no convex disc), too little sky, and short slices: no answer.
+    #[test]
+    fn no_earth_beside_sky_is_no_answer() {
+        let mut dist = std::vec![0u8; PW * PH];
+        let mut stack = std::vec![0u32; PW * PH];
+        let sky_only: Vec<u16> = (0..PW * PH)
+            .map(|i| {
+                if (5..8).contains(&(i % PW)) && i / PW < 4 {
+                    1200
+                } else {
+                    1000
+                }
+            })
+            .collect();
+        assert_eq!(
+            earth_distance(&sky_only, (PW, PH), &mut dist, &mut stack),
+            None
+        );
+        // Warm Earth with cold cloud bands every 8 columns and across the middle rows.
+        let clouds: Vec<u16> = (0..PW * PH)
+            .map(|i| {
+                let (x, y) = (i % PW, i / PW);
+                if x % 8 < 3 || (14..18).contains(&y) {
+                    1000
+                } else {
+                    1400
+                }
+            })
+            .collect();
+        assert_eq!(
+            earth_distance(&clouds, (PW, PH), &mut dist, &mut stack),
+            None
+        );
+        // The Earth over all but a 4-column band of sky.
+        let little_sky: Vec<u16> = (0..PW * PH)
+            .map(|i| if i % PW < 4 { 1000 } else { 1400 })
+            .collect();
+        assert_eq!(
+            earth_distance(&little_sky, (PW, PH), &mut dist, &mut stack),
+            None
+        );
+        let mean = plane(false);
+        assert!(earth_distance(&mean, (PW, PH), &mut dist, &mut stack).is_some());
+        assert_eq!(
+            earth_distance(&mean[..10], (PW, PH), &mut dist, &mut stack),
+            None
+        );
+        assert_eq!(
+            earth_distance(&mean, (PW, PH), &mut dist[..10], &mut stack),
+            None
+        );
+        assert_eq!(
+            earth_distance(&mean, (PW, PH), &mut dist, &mut stack[..10]),
+            None
+        );
+        let flat = std::vec![1000u16; PW * PH];
+        assert_eq!(earth_distance(&flat, (PW, PH), &mut dist, &mut stack), None);
+    }
+
+    /// The Otsu level against a brute-force search of the between-class variance over
+    /// every split of a two-level plane with noise.
+    #[test]
+    fn otsu_level_splits_two_levels() {
+        let mean: Vec<u16> = (0..400u16)
+            .map(|i| {
+                if i % 3 == 0 {
+                    2000 + i % 17
+                } else {
+                    1000 + i % 13
+                }
+            })
+            .collect();
+        let (level, cold) = otsu_level(&mean).expect("two levels");
+        assert!((1012..2000).contains(&level), "{level}");
+        assert_eq!(cold, mean.iter().filter(|&&m| m <= level).count());
+        assert_eq!(cold, mean.iter().filter(|&&m| m < 1500).count());
+    }
+}
