@@ -117,14 +117,15 @@ fn otsu_level(mean_dn: &[u16]) -> Option<(u16, usize, f32)> {
     Some((level.min(u32::from(u16::MAX)) as u16, best.2, cold_mean_dn))
 }
 
-/// Floods from `seed` over cells marked `from` (8-connected when `diagonal`, else
-/// 4-connected), marking them `to`; the cells reached, counting the seed (marked by
-/// the caller). `stack` holds ≥ one entry per cell (each is pushed once).
+/// Floods from `seed` over the cells whose mark `from` takes (8-connected when
+/// `diagonal`, else 4-connected), marking them `to`; the cells reached, counting the
+/// seed (marked by the caller). `stack` holds ≥ one entry per cell (each is pushed
+/// once: it is marked `to` when pushed, which `from` must not take).
 fn flood(
     marks: &mut [u8],
     (pw, ph): (usize, usize),
     seed: usize,
-    (from, to): (u8, u8),
+    (from, to): (impl Fn(u8) -> bool, u8),
     diagonal: bool,
     stack: &mut [u32],
 ) -> usize {
@@ -137,33 +138,30 @@ fn flood(
         top -= 1;
         let i = stack.get(top).copied().unwrap_or(0) as usize;
         let (cx, cy) = (i % pw.max(1), i / pw.max(1));
-        for (dx, dy) in [
-            (-1, 0),
-            (1, 0),
-            (0, -1),
-            (0, 1),
-            (-1, -1),
-            (1, -1),
-            (-1, 1),
-            (1, 1),
-        ]
-        .into_iter()
-        .take(if diagonal { 8 } else { 4 })
-        {
-            let (x, y) = (cx as isize + dx, cy as isize + dy);
-            if x < 0 || y < 0 || x as usize >= pw || y as usize >= ph {
-                continue;
-            }
-            let j = y as usize * pw + x as usize;
-            if marks.get(j) != Some(&from) {
-                continue;
+        let (left, right, up, down) = (cx > 0, cx + 1 < pw, cy > 0, cy + 1 < ph);
+        let mut visit = |inside: bool, j: usize| {
+            if !inside {
+                return;
             }
             if let (Some(m), Some(s)) = (marks.get_mut(j), stack.get_mut(top)) {
-                *m = to;
-                *s = j as u32;
-                top += 1;
-                reached += 1;
+                if from(*m) {
+                    *m = to;
+                    *s = j as u32;
+                    top += 1;
+                    reached += 1;
+                }
             }
+        };
+        // (`wrapping`: an index off the plane is never visited, `inside` is false.)
+        visit(left, i.wrapping_sub(1));
+        visit(right, i + 1);
+        visit(up, i.wrapping_sub(pw));
+        visit(down, i + pw);
+        if diagonal {
+            visit(left && up, i.wrapping_sub(pw + 1));
+            visit(right && up, i.wrapping_sub(pw).wrapping_add(1));
+            visit(left && down, (i + pw).wrapping_sub(1));
+            visit(right && down, i + pw + 1);
         }
     }
     reached
@@ -219,8 +217,17 @@ pub fn earth_distance(
     if cold * 1000 < MIN_SKY_PERMILLE * n {
         return None;
     }
+    // The Earth grows over the cells it touches above the dim level (its limb-darkened
+    // band, and the warm pieces beyond it).
+    let dim_dn = cold_mean_dn + (f32::from(level) - cold_mean_dn) * DIM_SHARE;
     for (m, &v) in marks.iter_mut().zip(mean_dn) {
-        *m = if v > level { WARM } else { COLD };
+        *m = if v > level {
+            WARM
+        } else if f32::from(v) > dim_dn {
+            DIM
+        } else {
+            COLD
+        };
     }
     // The warm side's large components are the Earth.
     let min_cells = (EARTH_MIN_PERMILLE * n).div_ceil(1000).max(1);
@@ -232,29 +239,18 @@ pub fn earth_distance(
         if let Some(m) = marks.get_mut(i) {
             *m = WARM_SEEN;
         }
-        if flood(marks, (pw, ph), i, (WARM, WARM_SEEN), true, stack) >= min_cells {
+        let warm = (|m| m == WARM, WARM_SEEN);
+        if flood(marks, (pw, ph), i, warm, true, stack) >= min_cells {
             if let Some(m) = marks.get_mut(i) {
                 *m = EARTH;
             }
-            flood(marks, (pw, ph), i, (WARM_SEEN, EARTH), true, stack);
+            let grown = (|m| m == WARM_SEEN || m == WARM || m == DIM, EARTH);
+            flood(marks, (pw, ph), i, grown, true, stack);
             earth = true;
         }
     }
     if !earth {
         return None;
-    }
-    // The Earth grown over the cells it touches above the dim level (its
-    // limb-darkened band, and the warm pieces beyond it).
-    let dim_dn = cold_mean_dn + (f32::from(level) - cold_mean_dn) * DIM_SHARE;
-    for (m, &v) in marks.iter_mut().zip(mean_dn) {
-        if *m != EARTH && f32::from(v) > dim_dn {
-            *m = DIM;
-        }
-    }
-    for i in 0..n {
-        if marks.get(i) == Some(&EARTH) {
-            flood(marks, (pw, ph), i, (DIM, EARTH), true, stack);
-        }
     }
     // The sky side: what the border reaches without crossing the Earth (4-connected,
     // as the Earth is 8-connected); the rest are the Earth's holes.
@@ -270,7 +266,7 @@ pub fn earth_distance(
             if let Some(m) = marks.get_mut(i) {
                 *m = SKY_SIDE;
             }
-            flood(marks, (pw, ph), i, (COLD, SKY_SIDE), false, stack);
+            flood(marks, (pw, ph), i, (|m| m == COLD, SKY_SIDE), false, stack);
         }
     }
     for m in marks.iter_mut() {
@@ -279,35 +275,33 @@ pub fn earth_distance(
     if !convex(marks, (pw, ph)) {
         return None;
     }
-    // Chebyshev distances by two raster passes (every step costs 1).
-    let at = |marks: &[u8], x: isize, y: isize| {
-        if x < 0 || y < 0 || x as usize >= pw || y as usize >= ph {
-            FAR
+    // Chebyshev distances by two raster passes (every step costs 1): from the
+    // neighbours before a cell (left, up-left, up, up-right), then after it.
+    let step = |marks: &[u8], inside: bool, j: usize| {
+        if inside {
+            marks.get(j).copied().unwrap_or(FAR).saturating_add(1)
         } else {
-            marks
-                .get(y as usize * pw + x as usize)
-                .copied()
-                .unwrap_or(FAR)
+            FAR
         }
     };
     for i in 0..n {
-        let (x, y) = ((i % pw) as isize, (i / pw) as isize);
-        let d = [(-1, 0), (-1, -1), (0, -1), (1, -1)]
-            .iter()
-            .map(|&(dx, dy)| at(marks, x + dx, y + dy).saturating_add(1))
-            .min()
-            .unwrap_or(FAR);
+        let (cx, cy) = (i % pw, i / pw);
+        let (left, right, up) = (cx > 0, cx + 1 < pw, cy > 0);
+        let d = step(marks, left, i.wrapping_sub(1))
+            .min(step(marks, up, i.wrapping_sub(pw)))
+            .min(step(marks, left && up, i.wrapping_sub(pw + 1)))
+            .min(step(marks, right && up, i.wrapping_sub(pw).wrapping_add(1)));
         if let Some(m) = marks.get_mut(i) {
             *m = (*m).min(d);
         }
     }
     for i in (0..n).rev() {
-        let (x, y) = ((i % pw) as isize, (i / pw) as isize);
-        let d = [(1, 0), (1, 1), (0, 1), (-1, 1)]
-            .iter()
-            .map(|&(dx, dy)| at(marks, x + dx, y + dy).saturating_add(1))
-            .min()
-            .unwrap_or(FAR);
+        let (cx, cy) = (i % pw, i / pw);
+        let (left, right, down) = (cx > 0, cx + 1 < pw, cy + 1 < ph);
+        let d = step(marks, right, i + 1)
+            .min(step(marks, down, i + pw))
+            .min(step(marks, right && down, i + pw + 1))
+            .min(step(marks, left && down, (i + pw).wrapping_sub(1)));
         if let Some(m) = marks.get_mut(i) {
             *m = (*m).min(d);
         }

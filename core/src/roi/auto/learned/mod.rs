@@ -2056,11 +2056,8 @@ impl AutoV2 {
             plane8,
             lv.sigma,
             work.sum.as_mut(),
-            |i| {
-                distance
-                    .get(i)
-                    .is_some_and(|&d| d > earth_mask::EXCLUDED_CELLS)
-            },
+            distance,
+            earth_mask::EXCLUDED_CELLS,
             earth_mask::MIN_SKY_PERMILLE,
         )?;
         let (root, w8, next, seeds) = sky_component(work, plane8)?;

@@ -232,42 +232,47 @@ pub fn deep_space_codes(
         plane,
         sigma_dn,
         scratch,
-        (|_| true, MIN_VALID_PERMILLE),
+        (None, MIN_VALID_PERMILLE),
     )
 }
 
-/// Stage 2e: [`deep_space_codes`] on the cells `sky` takes (the sky beside the Earth:
-/// its other cells are left out of the fit and coded 0, as unusable ones are), of
-/// which at least `min_sky_permille` of the plane's cells must be usable.
+/// Stage 2e: [`deep_space_codes`] on the sky beside the Earth, the cells whose
+/// `distance` (to the Earth, one per cell) exceeds `excluded` (the other cells are
+/// left out of the fit and coded 0, as unusable ones are), of which at least
+/// `min_sky_permille` of the plane's cells must be usable; `None` for a short
+/// `distance` too.
+#[allow(clippy::too_many_arguments)]
 pub fn sky_codes(
     mean_dn: &[u16],
     saturated_then_codes: &mut [u8],
     plane: (usize, usize),
     sigma_dn: u32,
     scratch: &mut [u32],
-    sky: impl Fn(usize) -> bool,
+    distance: &[u8],
+    excluded: u8,
     min_sky_permille: usize,
 ) -> Option<DeepSpace> {
+    let distance = distance.get(..plane.0 * plane.1)?;
     fit_codes(
         mean_dn,
         saturated_then_codes,
         plane,
         sigma_dn,
         scratch,
-        (sky, min_sky_permille),
+        (Some((distance, excluded)), min_sky_permille),
     )
 }
 
-/// [`deep_space_codes`] on the cells `fitted.0` takes, at least `fitted.1` ‰ of the
-/// plane's cells usable.
-#[inline(always)]
+/// [`deep_space_codes`] on the cells beyond `fitted.0`'s distance (all without it),
+/// at least `fitted.1` ‰ of the plane's cells usable. One function for both stages,
+/// not a generic one: a second copy of the fit cost the M7's flash 6 KB.
 fn fit_codes(
     mean_dn: &[u16],
     saturated_then_codes: &mut [u8],
     (pw, ph): (usize, usize),
     sigma_dn: u32,
     scratch: &mut [u32],
-    (fitted, min_valid_permille): (impl Fn(usize) -> bool, usize),
+    (fitted, min_valid_permille): (Option<(&[u8], u8)>, usize),
 ) -> Option<DeepSpace> {
     let n = pw * ph;
     let mean_dn = mean_dn.get(..n)?;
@@ -278,7 +283,7 @@ fn fit_codes(
     }
     let saturated_px: &[u8] = plane_codes;
     let usable_at = |i: usize| {
-        fitted(i)
+        fitted.is_none_or(|(distance, excluded)| distance.get(i).is_some_and(|&d| d > excluded))
             && usable(
                 mean_dn.get(i).copied().unwrap_or(0),
                 saturated_px.get(i).copied().unwrap_or(1),
