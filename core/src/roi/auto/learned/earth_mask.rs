@@ -259,14 +259,17 @@ pub fn earth_distance(
             *m = COLD;
         }
     }
-    for i in 0..n {
-        let (cx, cy) = (i % pw, i / pw);
-        let on_border = cx == 0 || cy == 0 || cx + 1 == pw || cy + 1 == ph;
-        if on_border && marks.get(i) == Some(&COLD) {
-            if let Some(m) = marks.get_mut(i) {
-                *m = SKY_SIDE;
+    // (Rows and columns, not `i % pw`: no division, and no panic path for `pw` 0.)
+    for cy in 0..ph {
+        for cx in 0..pw {
+            let i = cy * pw + cx;
+            let on_border = cx == 0 || cy == 0 || cx + 1 == pw || cy + 1 == ph;
+            if on_border && marks.get(i) == Some(&COLD) {
+                if let Some(m) = marks.get_mut(i) {
+                    *m = SKY_SIDE;
+                }
+                flood(marks, (pw, ph), i, (|m| m == COLD, SKY_SIDE), false, stack);
             }
-            flood(marks, (pw, ph), i, (|m| m == COLD, SKY_SIDE), false, stack);
         }
     }
     for m in marks.iter_mut() {
@@ -284,26 +287,30 @@ pub fn earth_distance(
             FAR
         }
     };
-    for i in 0..n {
-        let (cx, cy) = (i % pw, i / pw);
-        let (left, right, up) = (cx > 0, cx + 1 < pw, cy > 0);
-        let d = step(marks, left, i.wrapping_sub(1))
-            .min(step(marks, up, i.wrapping_sub(pw)))
-            .min(step(marks, left && up, i.wrapping_sub(pw + 1)))
-            .min(step(marks, right && up, i.wrapping_sub(pw).wrapping_add(1)));
-        if let Some(m) = marks.get_mut(i) {
-            *m = (*m).min(d);
+    for cy in 0..ph {
+        for cx in 0..pw {
+            let i = cy * pw + cx;
+            let (left, right, up) = (cx > 0, cx + 1 < pw, cy > 0);
+            let d = step(marks, left, i.wrapping_sub(1))
+                .min(step(marks, up, i.wrapping_sub(pw)))
+                .min(step(marks, left && up, i.wrapping_sub(pw + 1)))
+                .min(step(marks, right && up, i.wrapping_sub(pw).wrapping_add(1)));
+            if let Some(m) = marks.get_mut(i) {
+                *m = (*m).min(d);
+            }
         }
     }
-    for i in (0..n).rev() {
-        let (cx, cy) = (i % pw, i / pw);
-        let (left, right, down) = (cx > 0, cx + 1 < pw, cy + 1 < ph);
-        let d = step(marks, right, i + 1)
-            .min(step(marks, down, i + pw))
-            .min(step(marks, right && down, i + pw + 1))
-            .min(step(marks, left && down, (i + pw).wrapping_sub(1)));
-        if let Some(m) = marks.get_mut(i) {
-            *m = (*m).min(d);
+    for cy in (0..ph).rev() {
+        for cx in (0..pw).rev() {
+            let i = cy * pw + cx;
+            let (left, right, down) = (cx > 0, cx + 1 < pw, cy + 1 < ph);
+            let d = step(marks, right, i + 1)
+                .min(step(marks, down, i + pw))
+                .min(step(marks, right && down, i + pw + 1))
+                .min(step(marks, left && down, (i + pw).wrapping_sub(1)));
+            if let Some(m) = marks.get_mut(i) {
+                *m = (*m).min(d);
+            }
         }
     }
     let sky = marks.iter().filter(|&&d| d > EXCLUDED_CELLS).count();
