@@ -1041,7 +1041,9 @@ enum Departure {
 
 /// Fewest cells of stage 2e's component: one departing cell beside the Earth is the
 /// fitted sky's noise or a hot pixel as often as a target (the Python replay of
-/// session 57 took components of 2 cells and more).
+/// session 57 took components of 2 cells and more). Family A (session 58): 3 → no
+/// box moves (held out −0.0008), 4 → −0.0023, 6 → −0.0116 (fixtures A's small
+/// targets beside the Earth).
 pub const SKY_MIN_CELLS: u16 = 2;
 
 /// Confidence of a box of stage 2e (the sky beside the Earth), ‰: its hit rate
