@@ -2003,13 +2003,10 @@ impl AutoV2 {
             plane8,
             lv,
             (root, w8, next),
-            seeds,
+            (seeds, seen),
             scores,
         ) {
-            Departure::Boxed(d) => {
-                work.deep_space = Some(seen);
-                Some(d)
-            }
+            Departure::Boxed(d) => Some(d),
             // The surface was fitted to the Earth in part (its component departs
             // downwards) or the component is the Earth's (the limb, its disc in a
             // corner): the sky beside the Earth, fitted alone, may still hold a target.
@@ -2074,20 +2071,18 @@ impl AutoV2 {
             plane8,
             lv,
             (root, w8, next),
-            seeds,
+            (seeds, seen),
             scores,
         ) {
-            Departure::Boxed(d) => {
-                work.deep_space = Some(seen);
-                Some(d)
-            }
+            Departure::Boxed(d) => Some(d),
             Departure::Classifier | Departure::NoBox => None,
         }
     }
 
     /// Stages 2c and 2e: the seeded component `(root, w8, next)` of departing cells
-    /// (their [`Seeds`]) refined and judged as a target over the fitted sky; its box
-    /// carries `scores.0`, or `scores.1` when cut by the window's border.
+    /// (their [`Seeds`]; what the fit saw, kept in the work when boxed) refined and
+    /// judged as a target over the fitted sky; its box carries `scores.0`, or
+    /// `scores.1` when cut by the window's border.
     #[allow(clippy::too_many_arguments)]
     fn box_departure<C: FrameCapacity>(
         &self,
@@ -2097,7 +2092,7 @@ impl AutoV2 {
         plane8: (usize, usize),
         lv: FrameLevels,
         (root, w8, next): (u8, CellStats, usize),
-        seeds: Seeds,
+        (seeds, seen): (Seeds, smooth::DeepSpace),
         (interior_permille, border_permille): (u16, u16),
     ) -> Departure {
         // A component on the window's border may be the Earth's disc in a corner (the
@@ -2173,6 +2168,7 @@ impl AutoV2 {
             // A hot pixel's cell: a small target may still be there (stage 2d).
             return Departure::NoBox;
         }
+        work.deep_space = Some(seen);
         Departure::Boxed(if score_permille < self.min_score_permille {
             NO_TARGET
         } else {
