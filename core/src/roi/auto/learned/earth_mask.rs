@@ -3,27 +3,35 @@
 //! smooth surface to the whole window, which a frame holding both cannot be).
 //!
 //! The cells' means are split at their Otsu level; the warm side's 8-connected
-//! components of at least [`EARTH_MIN_PERMILLE`] of the cells are the Earth (a target
-//! is smaller; the disc or its limb band is larger), its holes filled (the disc's cold
-//! clouds are no sky: a hole is a region of the cold side the frame's border cannot
-//! reach, 4-connected), and grown over the cells it touches above a dimmer level
-//! ([`DIM_SHARE`]: its limb-darkened band). Each cell then gets its Chebyshev distance to the Earth, in
-//! cells ([`earth_distance`]): the caller fits the sky on cells beyond
-//! [`EXCLUDED_CELLS`] (the limb's blur and the disc's dark edge stay out of the fit)
-//! and rejects a component that reaches the first cell beyond them (the limb's own
-//! cold fragments; `docs/detectors.md` § Session 57: without that, 10 of famAE's 59
-//! mixed frames without a target were boxed on the limb, with it 1).
+//! components of at least [`EARTH_MIN_PERMILLE`] of the cells are the Earth (the disc
+//! or its limb band; most targets are smaller), grown over the cells they touch
+//! above a dimmer level ([`DIM_SHARE`]: the limb-darkened band), and their holes are
+//! filled (the disc's cold clouds are no sky: a hole is a region of the rest that the
+//! frame's border cannot reach, 4-connected). The Earth's disc is convex across the
+//! frame: its cells must cross nearly every row and column in one run
+//! ([`MAX_SPLIT_LINES_PERMILLE`]), else the frame is the Earth's alone, its cold clouds
+//! taken for sky. Each cell then gets its Chebyshev distance to the Earth, in cells
+//! ([`earth_distance`]): the caller fits the sky on cells beyond [`EXCLUDED_CELLS`]
+//! (the limb's blur and the disc's dark edge stay out of the fit) and rejects a
+//! component that reaches the first cell beyond them (the limb's own cold fragments;
+//! `docs/detectors.md` § Session 57: without that, 10 of famAE's 59 mixed frames
+//! without a target were boxed on the limb, with it 1).
 //!
-//! Chosen by a Python replay on family A (session 57, seeds 7001–7201): the share,
-//! the exclusion and the margin. Memory: the distances in a `u8` cell plane and a
-//! work stack of one `u32` per cell, both lent by the caller (`auto-v2`'s planes, free
-//! at this stage); on the stack a 64-bin histogram (256 B). Cost: a pass for the
-//! levels, one for the histogram, ≤ 2 flood fills of the warm side and one of the
-//! cold side (each cell pushed once per fill), two raster passes for the distances.
+//! Chosen on family A (seeds 7001–7201): the share, the exclusion and the margin by a
+//! Python replay (session 57), the convexity and the dim level in the core (session
+//! 58, `docs/detectors.md` § Session 58). Memory: the distances in a `u8` cell plane
+//! and a work stack of one `u32` per cell, both lent by the caller (`auto-v2`'s planes,
+//! free at this stage); on the stack a 64-bin histogram (256 B). Cost: a pass for the
+//! levels, one for the histogram, a flood fill of each warm component, a second of
+//! each large one with what it grows over, one of the sky side (each cell pushed once
+//! per fill), two passes over the rows and columns for the convexity and two raster
+//! passes for the distances: 0.55 M x86-64 instructions on a 41×31-cell frame where it
+//! runs in full (0.6 M on the Cortex-M7, `docs/flight.md` § Session 58).
 
-/// A warm component of at least this share of the cells, ‰, is the Earth (the
-/// `realistic` world's close targets cover at most 5 % of the cells; a limb band
-/// across a 640×512 frame two cells deep is 5 %, one that matters for the fit more).
+/// A warm component of at least this share of the cells, ‰, is the Earth (a limb band
+/// two cells deep across the 41 columns of a 328×248 frame is 6.5 %). A close target
+/// warmer than the split and this large is taken for Earth too: the stage then finds
+/// no target and the classifier decides, as before the stage.
 pub const EARTH_MIN_PERMILLE: usize = 80;
 
 /// Cells within this Chebyshev distance of the Earth are left out of the sky's fit
