@@ -48,7 +48,7 @@ pub const MARGIN_CELLS: u8 = EXCLUDED_CELLS + 1;
 pub const MIN_SKY_PERMILLE: usize = 200;
 
 /// At most this share of the rows and columns crossing the Earth's cells, ‰, may
-/// cross them in more than one run ([`convex`]). Chosen on family A (session 58, a
+/// cross them in more than one run (`convex`). Chosen on family A (session 58, a
 /// Python replay on the frames where stage 2e boxed): frames holding the Earth and sky
 /// split 0–8 % of their lines (the limb's clouds near the split level), but two of 15
 /// at 59 and 79 % (boxes at IoU 0.54 and 0.33); Earth-filled frames split 14–89 %
