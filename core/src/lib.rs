@@ -62,7 +62,7 @@
 //! | WGE | [`roi::wge::WgeScratch`] | [`roi::wge::SCRATCH_BYTES`] = 14 352 | 16 KiB |
 //! | DoG | [`roi::dog::DogScratch`] | [`roi::dog::SCRATCH_BYTES`] = 74 296 | 96 KiB |
 //! | auto | [`roi::auto::AutoScratch`] | [`roi::auto::SCRATCH_BYTES`] = 25 456 | 32 KiB |
-//! | auto-v2 | [`roi::auto::learned::AutoV2Scratch`] | [`roi::auto::learned::SCRATCH_BYTES`] = 48 792 | 48 KiB |
+//! | auto-v2 | [`roi::auto::learned::AutoV2Scratch`] | [`roi::auto::learned::SCRATCH_BYTES`] = 48 784 | 48 KiB |
 //!
 //! The exact figures are printed by `tirroi memory` and listed in `docs/detectors.md`.
 //! A sequence tracker ([`roi::track::Tracker`]: `auto-v2` over consecutive frames)
@@ -85,7 +85,7 @@
 //! | WGE | 14 352 | 24 024 | 35 928 |
 //! | DoG | 74 296 | 275 640 | 644 984 |
 //! | auto | 25 456 | 66 448 | 136 208 |
-//! | auto-v2 | 48 792 | 159 376 | 358 544 |
+//! | auto-v2 | 48 784 | 159 376 | 358 544 |
 //!
 //! ## Memory of the camera model
 //!

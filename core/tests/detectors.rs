@@ -1350,7 +1350,7 @@ const MEMORY_TABLE: [(&str, usize, Method, usize, usize); 5] = [
         tirroi_core::roi::auto::learned::SCRATCH_BYTES,
         Method::AutoV2,
         48 * 1024,
-        48_792,
+        48_784,
     ),
 ];
 

@@ -184,7 +184,9 @@ pub struct AutoV2 {
     /// it has one rated higher ([`polygon::Outline::score_permille`]) and passing the
     /// gate. Default on: on family A (seeds 7001, 7101, 7201) summed mean IoU +0.054,
     /// famA's radiometry close 0.382 → 0.553, the Tango close set 0.383 → 0.475, no false
-    /// alarm added on famAE (fixtures A: 1 of 80; `docs/detectors.md` § Session 55). It
+    /// alarm added on famAE (fixtures A: 1 of 80; `docs/detectors.md` § Session 55).
+    /// Since session 59 a shorter outline closed by the frame's border (a body cut by
+    /// the frame, [`polygon::MIN_BORDER_OUTLINE_PX`]) counts too: famAT +0.020. It
     /// costs one pass of the segment detector ([`segments`]) on those frames (the
     /// flight demo's Tango frame +3.3 M Cortex-M7 instructions).
     pub outline: bool,
