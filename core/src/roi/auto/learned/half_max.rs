@@ -25,7 +25,9 @@
 //! its sunlit face) are no longer cut away. So too for any other stage's box whose ring
 //! is a sky clipped at DN 0 (its median 0 DN: nothing around the box but clipped noise)
 //! and that holds no saturated pixel (whose optics' halo and a limb beside it would
-//! pass for faces).
+//! pass for faces) — or holds some, through optics that do not blur
+//! ([`Background::ClutteredSharp`], session 59: the `paper` world, whose Tango's sunlit
+//! face saturates beside faces in shadow, `paperAT/000282`).
 
 use super::order::select_binned;
 use crate::frame::Frame;
@@ -63,6 +65,12 @@ pub enum Background {
     /// around the box is deep space clipped at DN 0 (its median is 0) and the box holds
     /// no saturated pixel: then as [`Background::DeepSpace`].
     Cluttered,
+    /// As [`Background::Cluttered`], through optics without blur (no halo around a
+    /// saturated pixel): a ring at DN 0 makes the box's background deep space even when
+    /// it holds saturated pixels (`auto-v2` with `saturated_erode_px` 0). Family A
+    /// (seeds 7001–7201, ½ convention): paperAT 0.7593 → 0.7813, paper A +0.0027, no
+    /// set lower; held out paperBT +0.0121, paperB +0.0036.
+    ClutteredSharp,
     /// Deep space, as stage 2c fitted it (a smooth surface under white noise): there is
     /// no clutter to keep out, so a face counts from [`DEEP_SPACE_FACE_MIN_SIGMA`] σ
     /// (with a neighbour as far: no lone hot pixel) whatever the peak (a close target's
@@ -201,6 +209,7 @@ pub fn half_max_box(frame: &Frame<'_>, roi: Roi, sigma_dn: u32, background: Back
     let deep_space = match background {
         Background::DeepSpace => true,
         Background::Cluttered => bg == 0 && !saturated,
+        Background::ClutteredSharp => bg == 0,
     };
     let face_min = if deep_space {
         DEEP_SPACE_FACE_MIN_SIGMA.saturating_mul(sigma_dn.max(1))
@@ -419,7 +428,7 @@ mod tests {
     /// A box of any stage whose ring is a sky clipped at DN 0 (the `paper` world's deep
     /// space, `paperAT/000186`: a Tango's faces in shadow beside its sunlit face) is cut
     /// as over deep space; one holding a saturated pixel (a halo, a limb beside it)
-    /// as over the Earth.
+    /// as over the Earth, unless the optics do not blur (no halo: session 59).
     #[test]
     fn a_ring_at_dn_0_is_deep_space_unless_the_box_saturates() {
         let mut px = std::vec![0u16; FRAME_WIDTH * FRAME_HEIGHT];
@@ -446,6 +455,12 @@ mod tests {
         assert_eq!(
             half_max_box(&frame, wide, 10, Background::Cluttered),
             Roi::new(100, 60, 104, 65)
+        );
+        // Through optics without blur a saturated face leaves no halo: the ring at DN 0
+        // is deep space and the faces in shadow stay.
+        assert_eq!(
+            half_max_box(&frame, wide, 10, Background::ClutteredSharp),
+            all
         );
     }
 

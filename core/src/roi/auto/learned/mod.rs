@@ -108,7 +108,9 @@ pub struct AutoV2 {
     /// point-spread function ([`saturated::PSF_RADIUS_PX`]; the `realistic` world), where
     /// family A's realistic set chooses 2 of 0–3 (mean IoU 0.376, 0.414, 0.482, 0.457 at
     /// 0, 1, 2, 3). Set 0 for a camera without optics blur (the `paper` world, the
-    /// fixtures and the test-set composites: there 0 is best, 2 costs 0.20 and 0.05).
+    /// fixtures and the test-set composites: there 0 is best, 2 costs 0.20 and 0.05);
+    /// at 0 stage 7 also takes a box over a sky clipped at DN 0 as over deep space
+    /// when it holds saturated pixels ([`half_max::Background::ClutteredSharp`]).
     pub saturated_erode_px: u8,
     /// The whole body grown from the winner ([`body`]: faces hotter and colder than
     /// the background joined to it). [`body::BodyParams::OFF`] turns it off.
@@ -2481,9 +2483,12 @@ impl AutoV2 {
         });
         // Stage 7: small boxes cut to their half maximum (far targets' blur); over
         // deep space a weaker face counts from the noise alone (no clutter to keep
-        // out; session 57).
+        // out; session 57), and so over a sky clipped at DN 0 seen through optics
+        // that do not blur (no halo around a saturated face; session 59).
         let background = if space {
             half_max::Background::DeepSpace
+        } else if self.saturated_erode_px == 0 {
+            half_max::Background::ClutteredSharp
         } else {
             half_max::Background::Cluttered
         };
