@@ -1021,35 +1021,49 @@ fn deep_space_component<C: FrameCapacity>(
         return Some((root, w8, next, seeds));
     }
     // The roots of the components holding a seed (labels are `u8`).
-    let mut seeded = [false; 256];
+    let mut flags = [0u8; 256];
     let cells = work.labels8.as_ref().get(..n8)?.iter();
     for (&l, &code) in cells.zip(work.labels4.as_ref()) {
         if l != 0 && code > smooth::WEAK_CODE {
-            if let Some(s) = seeded.get_mut(usize::from(work.comps.find(l))) {
-                *s = true;
+            if let Some(f) = flags.get_mut(usize::from(work.comps.find(l))) {
+                *f = SEEDED_ROOT;
             }
         }
     }
-    // The strongest seeded root of enough cells (ties: the lowest label, as
-    // `choose_target`).
-    let mut fallback: Option<(u8, CellStats)> = None;
-    for (l, &is_seeded) in seeded.iter().enumerate().take(next).skip(1) {
-        if !is_seeded || work.comps.parents().get(l) != Some(&(l as u8)) {
+    let Some((root, w8)) =
+        strongest_flagged_root(work, &flags, next, DEEP_SPACE_FALLBACK_MIN_CELLS)
+    else {
+        return Some((root, w8, next, seeds));
+    };
+    Some((root, w8, next, seeds_of(work, n8, root)))
+}
+
+/// A root's flag in [`strongest_flagged_root`]: its component holds a seed (and
+/// nothing that rules it out).
+const SEEDED_ROOT: u8 = 1;
+
+/// Of the roots `1..next` of `labels8`'s components whose `flags` entry is exactly
+/// [`SEEDED_ROOT`], the strongest (summed energy) of at least `min_cells` cells, with
+/// its cell statistics (ties: the lowest label, as `choose_target`); `None` when none.
+fn strongest_flagged_root<C: FrameCapacity>(
+    work: &AutoV2Work<C>,
+    flags: &[u8; 256],
+    next: usize,
+    min_cells: usize,
+) -> Option<(u8, CellStats)> {
+    let mut best: Option<(u8, CellStats)> = None;
+    for (l, &f) in flags.iter().enumerate().take(next).skip(1) {
+        if f != SEEDED_ROOT || work.comps.parents().get(l) != Some(&(l as u8)) {
             continue;
         }
         let Some(c) = work.comps.stats(l) else {
             continue;
         };
-        if usize::from(c.area) >= DEEP_SPACE_FALLBACK_MIN_CELLS
-            && fallback.is_none_or(|(_, b)| c.energy > b.energy)
-        {
-            fallback = Some((l as u8, *c));
+        if usize::from(c.area) >= min_cells && best.is_none_or(|(_, b)| c.energy > b.energy) {
+            best = Some((l as u8, *c));
         }
     }
-    let Some((root, w8)) = fallback else {
-        return Some((root, w8, next, seeds));
-    };
-    Some((root, w8, next, seeds_of(work, n8, root)))
+    best
 }
 
 /// Fewest cells of the seeded component stage 2c takes when its strongest component
@@ -1111,8 +1125,7 @@ fn sky_component<C: FrameCapacity>(
         }
     }
     let (_, _, next) = strongest_component(work, plane8, CELL_RELABEL_CODES)?;
-    // Per root (labels are `u8`): bit 0 seeded, bit 1 at the Earth's margin.
-    const SEEDED: u8 = 1;
+    // Per root (labels are `u8`): seeded, and at the Earth's margin (refused).
     const AT_MARGIN: u8 = 2;
     let mut flags = [0u8; 256];
     let cells = work.labels8.as_ref().get(..n8)?.iter();
@@ -1121,23 +1134,11 @@ fn sky_component<C: FrameCapacity>(
             continue;
         }
         if let Some(f) = flags.get_mut(usize::from(work.comps.find(l))) {
-            *f |= (u8::from(code > smooth::WEAK_CODE) * SEEDED)
+            *f |= (u8::from(code > smooth::WEAK_CODE) * SEEDED_ROOT)
                 | (u8::from(d <= earth_mask::MARGIN_CELLS) * AT_MARGIN);
         }
     }
-    let mut best: Option<(u8, CellStats)> = None;
-    for (l, &f) in flags.iter().enumerate().take(next).skip(1) {
-        if f != SEEDED || work.comps.parents().get(l) != Some(&(l as u8)) {
-            continue;
-        }
-        let Some(c) = work.comps.stats(l) else {
-            continue;
-        };
-        if c.area >= SKY_MIN_CELLS && best.is_none_or(|(_, b)| c.energy > b.energy) {
-            best = Some((l as u8, *c));
-        }
-    }
-    let (root, w8) = best?;
+    let (root, w8) = strongest_flagged_root(work, &flags, next, usize::from(SKY_MIN_CELLS))?;
     Some((root, w8, next, seeds_of(work, n8, root)))
 }
 
