@@ -121,6 +121,20 @@ pub const MIN_BORDER_OUTLINE_PX: u32 = 25;
 /// or the body's piece of a target cut by the frame, boxed alone).
 pub const BORDER_OUTLINE_SCORE_PERMILLE: u16 = FEW_CORNERS_SCORE_PERMILLE;
 
+/// A group without a corner joins the outline's box (within [`ABSORB_REACH_PX`]) when
+/// its longest edge runs within this many degrees of parallel or perpendicular to the
+/// outline's longest edge: a part's own straight edges (a cylinder's sides along the
+/// body's face, a wing's edges), where cloud edges run any way. Session 59, family A
+/// (seeds 7001–7201, ½ convention; against cornered groups only): any length (the
+/// segment detector's 10 px) / ≥ 15 / ≥ 20 / ≥ 30 px → summed change of famA, paper
+/// A, fixtures A and famAF +0.0053 / +0.0042 / +0.0031 / +0.0013 (famAT +0.0029 /
+/// +0.0024 / +0.0018 / +0.0003, paperAT +0.0020 / +0.0016 / +0.0015 / 0), no set lower
+/// and no false alarm added at any; held out at any length +0.0036 (famBW +0.0054,
+/// paperBT +0.0022; famBT −0.0035, the real Earth −0.0009). Without the direction test
+/// (any group of ≥ 20 px) −0.0026 at 2 px, +0.0012 at 6 px (famAT −0.0038). The same
+/// tolerance as a continuation's ([`MAX_CONTINUATION_DEG`]).
+pub const MAX_PART_SQUARE_DEG: f32 = MAX_CONTINUATION_DEG;
+
 /// The outline the stage found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Outline {
@@ -234,6 +248,10 @@ struct Group {
     open_ends: u8,
     /// Sides of the frame its free ends reach: bits left, top, right, bottom.
     border_sides: u8,
+    /// Its longest segment's direction ([`Segment::dir_x`], [`Segment::dir_y`]).
+    dir: (i16, i16),
+    /// Its longest segment's length, quarter pixels.
+    longest_q: u16,
     x0_q: i16,
     y0_q: i16,
     x1_q: i16,
@@ -249,6 +267,8 @@ impl Group {
             corners: 0,
             open_ends: 0,
             border_sides: 0,
+            dir: (s.dir_x, s.dir_y),
+            longest_q: s.length_q,
             x0_q: s.x0_q.min(s.x1_q),
             y0_q: s.y0_q.min(s.y1_q),
             x1_q: s.x0_q.max(s.x1_q),
@@ -272,6 +292,8 @@ impl ConstInit for Group {
         corners: 0,
         open_ends: 0,
         border_sides: 0,
+        dir: (0, 0),
+        longest_q: 0,
         x0_q: i16::MAX,
         y0_q: i16::MAX,
         x1_q: i16::MIN,
@@ -286,6 +308,10 @@ impl Stats for Group {
         self.corners = self.corners.saturating_add(other.corners);
         self.open_ends = self.open_ends.saturating_add(other.open_ends);
         self.border_sides |= other.border_sides;
+        if other.longest_q > self.longest_q {
+            self.longest_q = other.longest_q;
+            self.dir = other.dir;
+        }
         self.x0_q = self.x0_q.min(other.x0_q);
         self.y0_q = self.y0_q.min(other.y0_q);
         self.x1_q = self.x1_q.max(other.x1_q);
@@ -370,12 +396,27 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
     if width == 0 || height == 0 {
         return None;
     }
-    // The other groups with a corner that reach the box take part in it (its box only:
-    // the outline's length, segments and corners stay its own group's).
+    // The other groups that reach the box take part in it (its box only: the outline's
+    // length, segments and corners stay its own group's): those with a corner, and
+    // those without one running square to the outline's longest edge (a part's own
+    // straight edges).
     let reach_q = (ABSORB_REACH_PX * 4) as i16;
+    let perpendicular_cos2 = cos2_scaled(90.0 - MAX_PART_SQUARE_DEG);
+    let square_cos2 = cos2_scaled(MAX_PART_SQUARE_DEG);
+    let square = |g: &Group| {
+        let dot =
+            i64::from(best.dir.0) * i64::from(g.dir.0) + i64::from(best.dir.1) * i64::from(g.dir.1);
+        let dot2 = dot * dot;
+        dot2 >= square_cos2 || dot2 <= perpendicular_cos2
+    };
+    let roots = || {
+        (0..n)
+            .filter(|&l| groups.parent(l) == Some(l as u8))
+            .filter_map(|l| groups.stats(l).copied())
+    };
     let mut b = best;
-    for g in cornered() {
-        if best.reaches(&g, reach_q) {
+    for g in roots() {
+        if best.reaches(&g, reach_q) && (g.corners > 0 || square(&g)) {
             b.merge(&g);
         }
     }
@@ -576,6 +617,27 @@ mod tests {
         let o = strongest(&[top, bottom, left], 120, 90).unwrap();
         assert!(!o.closed_by_border, "{o:?}");
         assert_eq!(o.roi.x1, 88);
+    }
+
+    #[test]
+    fn a_part_edge_square_to_the_outline_is_taken_in() {
+        // A lone edge beside the dark rectangle's right side, parallel to its top (a
+        // cylinder's side), 1.5 px away: its box joins; the same edge at 45° (a cloud's)
+        // does not, nor one beyond the reach.
+        let body = dark_rectangle();
+        let with = |part: Segment| -> [Segment; 5] {
+            core::array::from_fn(|i| if i < 4 { body[i] } else { part })
+        };
+        let along = seg(91.0, 40.0, 115.0, 40.0, 0.0, -1.0);
+        let o = strongest(&with(along), 160, 90).unwrap();
+        assert_eq!((o.segments, o.corners), (4, 4), "{o:?}");
+        assert_eq!(o.roi.x1, 115);
+        let upright = seg(91.0, 30.0, 91.0, 55.0, 1.0, 0.0);
+        assert_eq!(strongest(&with(upright), 160, 90).unwrap().roi.x1, 91);
+        let skew = seg(91.0, 40.0, 108.0, 57.0, 1.0, -1.0);
+        assert_eq!(strongest(&with(skew), 160, 90).unwrap().roi.x1, 89);
+        let far = seg(99.0, 40.0, 120.0, 40.0, 0.0, -1.0);
+        assert_eq!(strongest(&with(far), 160, 90).unwrap().roi.x1, 89);
     }
 
     #[test]
