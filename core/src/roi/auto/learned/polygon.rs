@@ -31,8 +31,8 @@
 //! 50 px.
 //!
 //! Memory: on the stack the group of each segment (1 B each), which of its ends meet
-//! another's (1 B each) and the groups' sums (16 B each) in the union-find: 1 728 B
-//! for [`MAX_SEGMENTS`]; no scratch.
+//! another's and each group's longest segment (1 B each) and the groups' sums (16 B
+//! each) in the union-find: 1 824 B for [`MAX_SEGMENTS`]; no scratch.
 //! Cost: every pair of segments once (at most 4 560 pairs for 96).
 
 use super::segments::{DIRECTION_ONE, MAX_SEGMENTS, Segment};
@@ -248,10 +248,6 @@ struct Group {
     open_ends: u8,
     /// Sides of the frame its free ends reach: bits left, top, right, bottom.
     border_sides: u8,
-    /// Its longest segment's direction ([`Segment::dir_x`], [`Segment::dir_y`]).
-    dir: (i16, i16),
-    /// Its longest segment's length, quarter pixels.
-    longest_q: u16,
     x0_q: i16,
     y0_q: i16,
     x1_q: i16,
@@ -267,8 +263,6 @@ impl Group {
             corners: 0,
             open_ends: 0,
             border_sides: 0,
-            dir: (s.dir_x, s.dir_y),
-            longest_q: s.length_q,
             x0_q: s.x0_q.min(s.x1_q),
             y0_q: s.y0_q.min(s.y1_q),
             x1_q: s.x0_q.max(s.x1_q),
@@ -292,8 +286,6 @@ impl ConstInit for Group {
         corners: 0,
         open_ends: 0,
         border_sides: 0,
-        dir: (0, 0),
-        longest_q: 0,
         x0_q: i16::MAX,
         y0_q: i16::MAX,
         x1_q: i16::MIN,
@@ -308,10 +300,6 @@ impl Stats for Group {
         self.corners = self.corners.saturating_add(other.corners);
         self.open_ends = self.open_ends.saturating_add(other.open_ends);
         self.border_sides |= other.border_sides;
-        if other.longest_q > self.longest_q {
-            self.longest_q = other.longest_q;
-            self.dir = other.dir;
-        }
         self.x0_q = self.x0_q.min(other.x0_q);
         self.y0_q = self.y0_q.min(other.y0_q);
         self.x1_q = self.x1_q.max(other.x1_q);
@@ -355,11 +343,19 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
             }
         }
     }
-    // The free ends: on the border (the sides they reach) or open.
+    // The free ends: on the border (the sides they reach) or open; and each group's
+    // longest segment (by its root's label; the first of equal lengths).
     let reach_q = CORNER_REACH_PX * 4;
     let (w_q, h_q) = (width as i32 * 4, height as i32 * 4);
+    let mut longest = [0u8; MAX_SEGMENTS];
     for (i, (s, &m)) in segments.iter().zip(&met).enumerate() {
         let root = groups.find(i as u8);
+        if let Some(l) = longest.get_mut(usize::from(root)) {
+            let held = segments.get(usize::from(*l)).map_or(0, |h| h.length_q);
+            if groups.find(*l) != root || s.length_q > held {
+                *l = i as u8;
+            }
+        }
         for (k, &(x, y)) in ends(s).iter().enumerate() {
             if m & (1 << k) != 0 {
                 continue;
@@ -377,21 +373,21 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
             }
         }
     }
-    // The groups with a corner (their roots' statistics).
-    let cornered = || {
+    // The groups (their roots' labels and statistics), and those with a corner.
+    let roots = || {
         (0..n)
             .filter(|&l| groups.parent(l) == Some(l as u8))
-            .filter_map(|l| groups.stats(l).copied())
-            .filter(|g| g.corners > 0)
+            .filter_map(|l| groups.stats(l).map(|g| (l, *g)))
     };
+    let cornered = || roots().filter(|(_, g)| g.corners > 0);
     let closed_by_border = |g: &Group| g.open_ends == 0 && g.border_sides != 0;
-    let best = cornered()
-        .filter(|g| {
+    let (best_root, best) = cornered()
+        .filter(|(_, g)| {
             let length_px = g.length_q / 4;
             length_px >= MIN_OUTLINE_PX
                 || (closed_by_border(g) && length_px >= MIN_BORDER_OUTLINE_PX)
         })
-        .max_by_key(|g| g.length_q)?;
+        .max_by_key(|(_, g)| g.length_q)?;
     let length_px = best.length_q / 4;
     if width == 0 || height == 0 {
         return None;
@@ -403,20 +399,22 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
     let reach_q = (ABSORB_REACH_PX * 4) as i16;
     let perpendicular_cos2 = cos2_scaled(90.0 - MAX_PART_SQUARE_DEG);
     let square_cos2 = cos2_scaled(MAX_PART_SQUARE_DEG);
-    let square = |g: &Group| {
-        let dot =
-            i64::from(best.dir.0) * i64::from(g.dir.0) + i64::from(best.dir.1) * i64::from(g.dir.1);
+    let longest_of = |root: usize| {
+        longest
+            .get(root)
+            .and_then(|&i| segments.get(usize::from(i)))
+            .map_or((0, 0), |s| (i64::from(s.dir_x), i64::from(s.dir_y)))
+    };
+    let best_dir = longest_of(best_root);
+    let square = |root: usize| {
+        let dir = longest_of(root);
+        let dot = best_dir.0 * dir.0 + best_dir.1 * dir.1;
         let dot2 = dot * dot;
         dot2 >= square_cos2 || dot2 <= perpendicular_cos2
     };
-    let roots = || {
-        (0..n)
-            .filter(|&l| groups.parent(l) == Some(l as u8))
-            .filter_map(|l| groups.stats(l).copied())
-    };
     let mut b = best;
-    for g in roots() {
-        if best.reaches(&g, reach_q) && (g.corners > 0 || square(&g)) {
+    for (l, g) in roots() {
+        if best.reaches(&g, reach_q) && (g.corners > 0 || square(l)) {
             b.merge(&g);
         }
     }
