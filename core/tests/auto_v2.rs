@@ -732,6 +732,57 @@ fn spots_replace_a_weaker_answer_and_only_that() {
     assert!(replaced > 0 && kept > 0, "replaced {replaced}, kept {kept}");
 }
 
+/// A region answer rated at or above `spot_competes_below_permille` stands against the
+/// spots under the gate too, so a gate one ‰ above it gives "no target", never a spot:
+/// the gate decides whether the answer is given, not which. The fuzz target's input
+/// `crash-389043c4` (session 60): a 256 × 89 frame of a 4-pixel period (3, 0, 0, 16 384
+/// DN at 9 bits), the saturated blob always rated (`BlobRule::Always`) at 0 ‰ with
+/// competition off (0); before the fix a gate of 1 ‰ gave stage 5e's spot at 46 ‰.
+#[test]
+fn a_stricter_gate_never_brings_up_a_spot() {
+    let (w, h) = (256, 89);
+    let period = [3u16, 0, 0, 16_384];
+    let img = Img {
+        px: (0..w * h).map(|i| period[i % period.len()]).collect(),
+        w,
+        h,
+        bits: 9,
+    };
+    let det = AutoV2 {
+        fine_sigma: 39,
+        cell_score: 2903,
+        min_score_permille: 0,
+        saturated_erode_px: 2,
+        body: BodyParams::OFF,
+        prescreen: false,
+        deep_space: false,
+        sky_beside_earth: false,
+        small_target: true,
+        blob: BlobRule::Always,
+        candidates: 2,
+        spot: true,
+        spot_competes_below_permille: 0,
+        outline: false,
+        link_cells: 1,
+        ..AutoV2::default()
+    };
+    let mut scratch = Box::new(AutoV2Scratch::new());
+    let d = det.detect(&img.frame(), &mut scratch).unwrap();
+    assert!(d.roi.is_some() && scratch.work().blob_won(), "{d:?}");
+    assert_eq!(d.score_permille, 0, "{d:?}");
+    check(&img, det).unwrap();
+    // Every gate above the blob's rating: "no target" (the spots do not compete).
+    for gate in [1, 46, 550] {
+        let stricter = AutoV2 {
+            min_score_permille: gate,
+            ..det
+        };
+        let n = stricter.detect(&img.frame(), &mut scratch).unwrap();
+        assert_eq!((n.roi, n.score_permille), (None, 0), "gate {gate}");
+        assert_eq!(scratch.work().spot(), None, "gate {gate}");
+    }
+}
+
 /// Stage 5f, the straight outline (`AutoV2::outline`), against its rule built from
 /// parts: the answer without it (`outline: false`), and the frame's outline from
 /// `learned::frame_segments` and `polygon::strongest` (the stage's own parts, called

@@ -169,8 +169,10 @@ pub struct AutoV2 {
     /// the target is) is rated below this, ‰, the spots are rated too, and the most confident
     /// spot replaces that box when it is rated higher (both are calibrated P(hit), so
     /// the likelier hit wins: a far target among clutter against a piece of the limb
-    /// or a cloud edge passed at 0.6). Only with [`AutoV2::spot`]; 0 turns it off (the
-    /// spots run only after "no target"); 0..=1000, else
+    /// or a cloud edge passed at 0.6). A region answer rated at least this stands, under
+    /// the gate too: a gate above it then gives "no target" rather than a spot (the
+    /// answer does not depend on the gate). Only with [`AutoV2::spot`]; 0 turns it off
+    /// (the spots run only when no region stage has an answer); 0..=1000, else
     /// [`DetectError::InvalidParameter`]. It costs one run of stage 5e (at most 5.5 M
     /// Cortex-M7 instructions per 328×248 frame) on the frames whose answer is rated
     /// below it. Default 800, chosen on family A (seeds 7001 and 7201; summed gated
@@ -1730,7 +1732,27 @@ impl AutoV2 {
         plane8: (usize, usize),
         lv: FrameLevels,
     ) -> Detection {
-        let d = self.region_stages(frame, work, win, plane8, lv);
+        // A region answer rated at least `spot_competes_below_permille` stands against
+        // the spots, under the gate too (then "no target"): the region stages run at
+        // the lower of the two, so that the gate only decides whether the answer is
+        // given and a stricter gate never brings up another stage's box (the fuzz
+        // target's property). The default's spots compete above the gate (800 ≥ 550):
+        // the region stages then run at the gate itself, every answer as before.
+        let region_gate = if self.spot {
+            self.min_score_permille
+                .min(self.spot_competes_below_permille)
+        } else {
+            self.min_score_permille
+        };
+        let d = if region_gate < self.min_score_permille {
+            AutoV2 {
+                min_score_permille: region_gate,
+                ..*self
+            }
+            .region_stages(frame, work, win, plane8, lv)
+        } else {
+            self.region_stages(frame, work, win, plane8, lv)
+        };
         let d = if d
             .roi
             .is_some_and(|r| r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX)
@@ -1743,6 +1765,18 @@ impl AutoV2 {
         } else {
             d
         };
+        if let Some(r) = d.roi.filter(|_| d.score_permille < self.min_score_permille) {
+            // Standing under the gate: no target, and a tracker's candidate at the
+            // floor (as a region winner under the gate is).
+            if work.candidate.is_none()
+                && self
+                    .candidate_floor_permille
+                    .is_some_and(|f| d.score_permille >= f)
+            {
+                work.candidate = Some((r, d.score_permille));
+            }
+            return NO_TARGET;
+        }
         if d.roi.is_some() {
             // A weak answer of a whole-frame search: stage 5e competes, the likelier hit
             // wins (in a tracking window the prior says where the target is).
