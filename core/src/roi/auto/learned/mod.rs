@@ -2558,9 +2558,14 @@ impl AutoV2 {
             half_max::Background::Cluttered
         };
         let roi = roi.map(|r| half_max::half_max_box(frame, r, lv.sigma, background));
-        // Stage 8: a saturated blob cut back by the optics' spread.
-        let roi =
-            roi.map(|r| saturated::saturated_box(frame, r, u16::from(self.saturated_erode_px)));
+        // Stage 8: a saturated blob cut back by the optics' spread; a saturated core
+        // (narrower than that spread: a target barely above the top DN) taken to the
+        // target's half maximum around it instead (session 60).
+        let erode_px = u16::from(self.saturated_erode_px);
+        let roi = roi.map(|r| match saturated::saturated_core(frame, r, erode_px) {
+            Some(around) => half_max::half_max_box(frame, around, lv.sigma, background),
+            None => saturated::saturated_box(frame, r, erode_px),
+        });
         Detection {
             roi,
             threshold: tau.into(),

@@ -15,6 +15,14 @@
 //! target). So the blob is cut only when the ring just beyond its halo is not
 //! brighter than the ring outside that ([`continues_beyond`]); otherwise the box stays
 //! the earlier stages' and the body stage grows it.
+//!
+//! Nor is a target saturated only in its middle (session 60): light spread by a kernel
+//! of reach r saturates at least 2r + 1 px across around any target far hotter than
+//! the top DN, so a blob narrower than that on a side is the *core* of a target
+//! barely above the top DN, whose outline lies beyond it (`famA/000168`: a 5×5 px
+//! target saturated on 3×2 px). Cutting it would leave a pixel (then no box at all):
+//! [`saturated_core`] gives its box instead, for the caller to take to the target's
+//! half maximum.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -215,6 +223,34 @@ fn blob_hull(frame: &Frame<'_>, roi: Roi) -> Option<Roi> {
     (halo_only && !continues_beyond(frame, hull)).then_some(hull)
 }
 
+/// True when the saturated blob's box `hull` is narrower on a side than the light of
+/// a target far above the top DN saturates through a kernel of reach `erode_px`
+/// (2 · `erode_px` + 1 px): the blob is the core of a target barely above the top DN
+/// (see the module). Never with `erode_px` 0 (optics that do not blur).
+fn is_core(hull: Roi, erode_px: u16) -> bool {
+    let across = 2 * erode_px + 1;
+    hull.width() < across || hull.height() < across
+}
+
+/// The box of the saturated core of the target in `roi` (see the module): when `roi`
+/// is a saturated blob and its halo, as [`saturated_box`] asks, but the blob is
+/// narrower on a side than 2 · `erode_px` + 1 px, its box grown by `erode_px` + 1 px
+/// per side (the kernel's reach and the pixel the halo may hold), cut to the frame;
+/// `None` otherwise ([`saturated_box`] decides). The target's outline lies in it.
+pub fn saturated_core(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Option<Roi> {
+    let hull = blob_hull(frame, roi).filter(|&h| is_core(h, erode_px))?;
+    let grow = erode_px + 1;
+    Some(
+        Roi::new(
+            hull.x0.saturating_sub(grow),
+            hull.y0.saturating_sub(grow),
+            hull.x1.saturating_add(grow),
+            hull.y1.saturating_add(grow),
+        )
+        .clip(frame.width() as u16, frame.height() as u16),
+    )
+}
+
 /// True when `roi` is a saturated blob and its halo ([`saturated_box`] cuts it).
 pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
     blob_hull(frame, roi).is_some()
@@ -224,10 +260,11 @@ pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
 /// least [`MIN_BLOB_PX`] pixels at the top DN, reaches at most
 /// [`PSF_RADIUS_PX`] + 1 px beyond their box on every side (it is that blob and its
 /// halo, not a larger body with a saturated face) and the target does not go on
-/// beyond the halo ([`continues_beyond`]), the blob's box cut by `erode_px` per side
-/// off the frame's edges; otherwise `roi` unchanged. The result lies inside `roi`.
+/// beyond the halo ([`continues_beyond`]), and the blob is no core ([`saturated_core`]),
+/// the blob's box cut by `erode_px` per side off the frame's edges; otherwise `roi`
+/// unchanged. The result lies inside `roi`.
 pub fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
-    let Some(hull) = blob_hull(frame, roi) else {
+    let Some(hull) = blob_hull(frame, roi).filter(|&h| !is_core(h, erode_px)) else {
         return roi;
     };
     let (fw, fh) = (frame.width() as u16, frame.height() as u16);
@@ -276,6 +313,8 @@ mod tests {
         assert_eq!(got, Roi::new(100, 50, 108, 56));
         // No cut: the blob's box.
         assert_eq!(saturated_box(&frame, found, 0), Roi::new(98, 48, 110, 58));
+        // Far hotter than the top DN: no core (the blob is the face dilated).
+        assert_eq!(saturated_core(&frame, found, PSF_RADIUS_PX), None);
         // A larger body with a saturated face: unchanged.
         let body = Roi::new(60, 20, 140, 90);
         assert_eq!(saturated_box(&frame, body, 2), body);
@@ -291,6 +330,58 @@ mod tests {
         let flat = std::vec![700u16; FRAME_WIDTH * FRAME_HEIGHT];
         let frame = Frame::new(&flat, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         assert_eq!(saturated_box(&frame, found, 2), found);
+    }
+
+    /// A target barely above the top DN (a 4×4 px face at twice the top DN over the
+    /// background, blurred by the 5×5 box): only the pixels whose kernel holds at least
+    /// 11 of its 16 saturate, the face less its corners, a core 4 px across, narrower
+    /// than the 8 px the kernel spreads a far hotter target to. Its box is not cut ([`saturated_box`] keeps the caller's);
+    /// [`saturated_core`] gives the core grown by the kernel's reach and a pixel, which
+    /// holds the face. Without blur (`erode_px` 0) no blob is a core; the far hotter
+    /// blob of the test above is none either.
+    #[test]
+    fn a_saturated_core_is_not_cut() {
+        let top = 4095u32;
+        let (rx0, ry0) = (120usize, 90usize);
+        let mut px = std::vec![700u16; FRAME_WIDTH * FRAME_HEIGHT];
+        for y in ry0 - 4..ry0 + 8 {
+            for x in rx0 - 4..rx0 + 8 {
+                let covered = (0..25)
+                    .filter(|k| {
+                        let (sx, sy) = ((x + k % 5).wrapping_sub(2), (y + k / 5).wrapping_sub(2));
+                        (rx0..rx0 + 4).contains(&sx) && (ry0..ry0 + 4).contains(&sy)
+                    })
+                    .count() as u32;
+                px[y * FRAME_WIDTH + x] = (700 + covered * top * 2 / 25).min(top) as u16;
+            }
+        }
+        let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
+        let saturated: std::vec::Vec<(usize, usize)> = (0..FRAME_WIDTH * FRAME_HEIGHT)
+            .filter(|&i| u32::from(px[i]) >= top)
+            .map(|i| (i % FRAME_WIDTH, i / FRAME_WIDTH))
+            .collect();
+        let face: std::vec::Vec<(usize, usize)> = (ry0..ry0 + 4)
+            .flat_map(|y| (rx0..rx0 + 4).map(move |x| (x, y)))
+            .filter(|&(x, y)| !((x == rx0 || x == rx0 + 3) && (y == ry0 || y == ry0 + 3)))
+            .collect();
+        assert_eq!(saturated, face, "the face less its corners");
+        // The core and a pixel of halo, as the boundary rule finds it.
+        let found = Roi::new(119, 89, 125, 95);
+        assert_eq!(saturated_box(&frame, found, 2), found);
+        let around = saturated_core(&frame, found, 2).expect("a core");
+        assert_eq!(around, Roi::new(117, 87, 127, 97));
+        assert!(around.contains_roi(&Roi::new(120, 90, 124, 94)), "the face");
+        assert_eq!(saturated_core(&frame, found, 0), None);
+        // A core at the frame's corner: the grown box is cut to the frame.
+        let mut corner = std::vec![700u16; FRAME_WIDTH * FRAME_HEIGHT];
+        for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            corner[y * FRAME_WIDTH + x] = top as u16;
+        }
+        let frame = Frame::new(&corner, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
+        assert_eq!(
+            saturated_core(&frame, Roi::new(0, 0, 3, 3), 2),
+            Some(Roi::new(0, 0, 5, 5))
+        );
     }
 
     /// The rings against a brute-force walk of the frame (Chebyshev distance of every
