@@ -648,6 +648,68 @@ mod tests {
         }
     }
 
+    /// A faint rectangle (16 DN under its background, 8 σ of the noise, each side a
+    /// 3-px ramp as the optics blur it): no 2×2 block of the fine pass reaches the seed
+    /// threshold (its gradient ≤ 2 · 16 / 3 + 2 · 6 per component), so it finds none;
+    /// binned 2×2 the sides step by 10 σ of a coarse block's gradient and the coarse
+    /// pass gives the four, in the frame's pixels.
+    #[test]
+    fn a_faint_rectangle_is_found_binned() {
+        let ramp = |v: usize, lo: usize, hi: usize| {
+            let v = v as f32;
+            ((v - lo as f32 + 1.0) / 3.0).clamp(0.0, 1.0)
+                * ((hi as f32 - v + 1.0) / 3.0).clamp(0.0, 1.0)
+        };
+        let mut state = 777u32;
+        let px: std::vec::Vec<u16> = (0..W * H)
+            .map(|i| {
+                state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                let noise = ((state >> 16) % 7) as f32;
+                let (x, y) = (i % W, i / W);
+                (3000.0 - 16.0 * ramp(x, 30, 89) * ramp(y, 25, 64) + noise) as u16
+            })
+            .collect();
+        // Uniform noise over 0..=6: σ = 2 DN.
+        assert!(run(&px, 2).is_empty(), "{:?}", run(&px, 2));
+        let frame = Frame::new(&px, W, H, 14).unwrap();
+        let (mut lo, mut hi) = (vec![0u32; 100], vec![0u32; 0]);
+        let mut marks = Marks::new(&mut lo, &mut hi, (W / 2) * (H / 2)).unwrap();
+        let mut out = [Segment::default(); MAX_SEGMENTS];
+        let n = detect_coarse(&frame, 2, &mut marks, &mut out);
+        let segs = &out[..n];
+        assert_eq!(segs.len(), 4, "{segs:?}");
+        let mut sides = [false; 4];
+        for s in segs {
+            let (x0, y0, x1, y1) = (
+                s.x0_q as f32 / 4.0,
+                s.y0_q as f32 / 4.0,
+                s.x1_q as f32 / 4.0,
+                s.y1_q as f32 / 4.0,
+            );
+            // The middle within 1.5 px of its side, the ends within 3 px of each
+            // other across it (a grid pixel's error over 55 px: under 3° of tilt).
+            if (x1 - x0).abs() > (y1 - y0).abs() {
+                // The top ramp rises over rows 24–26, the bottom over 63–65.
+                let y = (y0 + y1) / 2.0;
+                let k = usize::from(y > 45.0);
+                assert!((y - [25.0, 64.0][k]).abs() < 1.5, "{s:?}");
+                assert!((y0 - y1).abs() < 3.0, "{s:?}");
+                assert!(((x1 - x0).abs() - 60.0).abs() < 8.0, "{s:?}");
+                assert_eq!(s.dir_y.signum(), [-1, 1][k], "outwards: {s:?}");
+                sides[k] = true;
+            } else {
+                assert!((x0 - x1).abs() < 3.0, "{s:?}");
+                let x = (x0 + x1) / 2.0;
+                let k = usize::from(x > 60.0);
+                assert!((x - [30.0, 89.0][k]).abs() < 1.5, "{s:?}");
+                assert!(((y1 - y0).abs() - 40.0).abs() < 8.0, "{s:?}");
+                assert_eq!(s.dir_x.signum(), [-1, 1][k], "outwards: {s:?}");
+                sides[2 + k] = true;
+            }
+        }
+        assert_eq!(sides, [true; 4], "{segs:?}");
+    }
+
     #[test]
     fn a_disc_and_noise_give_no_long_segment() {
         // A disc of radius 30 px: its edge bends 22.5° every ~12 px, so pieces stay
