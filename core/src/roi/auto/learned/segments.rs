@@ -93,7 +93,8 @@ pub const MAX_REGION_BLOCKS: u32 = 4096;
 const MIN_REGION_BLOCKS: u32 = 10;
 
 /// Blocks taken into regions per frame, at most: the detector stops there (the
-/// segments found so far stand). A real frame's segments hold up to 3 535 blocks
+/// segments found so far stand; the coarse pass at a [`COARSE_PX`]² share of it, as
+/// of the blocks). A real frame's segments hold up to 3 535 blocks
 /// (session 55: famA, famAT, famB, famBW, fixtures A, paper A, the real Earth), its
 /// regions a few thousand more; a frame of edges everywhere (`plate-holes-2` of the
 /// worst-case set: every block an edge) would take every one of its 81 000 blocks,
@@ -362,7 +363,8 @@ fn run(
         edge2,
         pass,
         frontier: [0u32; FRONTIER_BLOCKS],
-        left: MAX_FRAME_BLOCKS,
+        // The coarse grid's share: a quarter of the blocks, a quarter of the budget.
+        left: MAX_FRAME_BLOCKS / (s * s) as u32,
     };
     // A seed block at (x, y) with gradient (gx, gy): its region, kept as a segment when
     // it is one; false when the frame's blocks are spent.
