@@ -74,11 +74,11 @@ pub const COARSE_PX: usize = 2;
 
 /// Least ratio of length to width of a coarse segment. Binned, a cloud's ragged edge
 /// runs straight for 10 grid pixels now and then; chosen on family A (stage 5f's
-/// outlines from the coarse segments when the fine ones give none; summed gated mean
-/// IoU, ½ convention): 4 → famA +0.0028, famAT +0.0096 but 3 false alarms added
-/// (famA 1, famAE 2); **5** → famA +0.0010, famAT +0.0102, no false alarm added, no
-/// set lower; 6 → famAT +0.0098 and fixtures A −0.0001 (`docs/detectors.md` §
-/// Session 60).
+/// outlines from the coarse segments when the fine ones give none; gated mean IoU, ½
+/// convention, change against no coarse pass): 4 → famA +0.0022, famAT +0.0104 but 3
+/// false alarms added on famAE; **5** → famA +0.0012, famAT +0.0084, paper A's Tango
+/// +0.0002, no false alarm added, no set lower; 6 → famA +0.0012, famAT +0.0081
+/// (`docs/detectors.md` § Session 60).
 pub const COARSE_MIN_ELONGATION: f32 = 5.0;
 
 /// Blocks waiting to be grown from at once (a region whose frontier is longer stops
