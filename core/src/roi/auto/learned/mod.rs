@@ -795,22 +795,6 @@ impl<C: FrameCapacity> AutoV2Work<C> {
         }
     }
 
-    /// The frame's straight edges binned 2×2 ([`segments::detect_coarse`]), with the
-    /// same marks (a quarter of them).
-    fn coarse_segments(
-        &mut self,
-        frame: &Frame<'_>,
-        sigma: u32,
-        out: &mut [segments::Segment],
-    ) -> usize {
-        let grid_px =
-            (frame.width() / segments::COARSE_PX) * (frame.height() / segments::COARSE_PX);
-        match segments::Marks::new(self.sum.as_mut(), self.sum_sq.as_mut(), grid_px) {
-            Some(mut marks) => segments::detect_coarse(frame, sigma, &mut marks, out),
-            None => 0,
-        }
-    }
-
     /// What the region stage chose on the last frame (`None` when stage 4d found its
     /// box to be the Earth's limb at the frame's border, or the box was under
     /// [`MIN_BOX_SIDE_PX`]).
@@ -963,9 +947,7 @@ pub fn frame_segments<C: FrameCapacity>(
 }
 
 /// Stage 5f ([`polygon`]): the frame's straight outline, from its segments (on the
-/// stack, [`segments::MAX_SEGMENTS`] of 16 B) found with the integral planes' marks;
-/// when they give none, from the segments of the frame binned 2×2 (session 60: a faint
-/// face's blurred edges, [`segments::detect_coarse`]; the same slots).
+/// stack, [`segments::MAX_SEGMENTS`] of 16 B) found with the integral planes' marks.
 #[inline(never)]
 fn outline_stage<C: FrameCapacity>(
     frame: &Frame<'_>,
@@ -974,12 +956,7 @@ fn outline_stage<C: FrameCapacity>(
 ) -> Option<polygon::Outline> {
     let mut segs = [segments::Segment::default(); segments::MAX_SEGMENTS];
     let n = work.segments(frame, sigma, &mut segs);
-    let (w, h) = (frame.width(), frame.height());
-    if let Some(o) = polygon::strongest(segs.get(..n)?, w, h) {
-        return Some(o);
-    }
-    let n = work.coarse_segments(frame, sigma, &mut segs);
-    polygon::strongest(segs.get(..n)?, w, h)
+    polygon::strongest(segs.get(..n)?, frame.width(), frame.height())
 }
 
 /// Stages 1–3: prepares the planes ([`prepare`]), computes the features of the 8×8

@@ -19,14 +19,6 @@
 //! The segment keeps its mean gradient direction (towards the brighter side), so a
 //! group of segments knows on which side of each edge its darker region lies.
 //!
-//! A coarse pass ([`detect_coarse`], session 60) runs the same detector on the frame
-//! binned 2×2 ([`COARSE_PX`]; the sums read on the fly, no copy): a dark face over
-//! the dark Earth steps by ~8 pixel σ, spread by the optics over 2–3 px, which a 2×2
-//! block reads as ~3 σ of its gradient (`famA/000047`: 150–250 DN at σ 24 DN), under
-//! the edge threshold; on the binned grid the same step is a one-pixel step at ~13 σ.
-//! Cloud edges straighten when binned too, so its segments must be longer against
-//! their width ([`COARSE_MIN_ELONGATION`]).
-//!
 //! Memory: one bit per pixel, lent by the caller ([`Marks`], 10 168 B at 328×248 in two
 //! slices of `auto-v2`'s integral planes, free at this stage); on the stack a frontier
 //! of [`FRONTIER_BLOCKS`] block indices (1 KiB) and the [`MAX_SEGMENTS`] segments
@@ -67,20 +59,6 @@ pub const MIN_LENGTH_PX: f32 = 10.0;
 /// wide; a blob of texture is not.
 pub const MIN_ELONGATION: f32 = 3.0;
 
-/// Pixels per side of a grid pixel of the coarse pass ([`detect_coarse`]): the sum of
-/// 2×2 pixels (noise 2 σ; a block's gradient component 4 σ). Lengths and widths of
-/// that pass are in its grid pixels (a segment from 20 px).
-pub const COARSE_PX: usize = 2;
-
-/// Least ratio of length to width of a coarse segment. Binned, a cloud's ragged edge
-/// runs straight for 10 grid pixels now and then; chosen on family A (stage 5f's
-/// outlines from the coarse segments when the fine ones give none; gated mean IoU, ½
-/// convention, change against no coarse pass): 4 → famA +0.0022, famAT +0.0104 but 3
-/// false alarms added on famAE; **5** → famA +0.0012, famAT +0.0084, paper A's Tango
-/// +0.0002, no false alarm added, no set lower; 6 → famA +0.0012, famAT +0.0081
-/// (`docs/detectors.md` § Session 60).
-pub const COARSE_MIN_ELONGATION: f32 = 5.0;
-
 /// Blocks waiting to be grown from at once (a region whose frontier is longer stops
 /// widening there: a straight edge's frontier is a few blocks).
 pub const FRONTIER_BLOCKS: usize = 256;
@@ -93,8 +71,7 @@ pub const MAX_REGION_BLOCKS: u32 = 4096;
 const MIN_REGION_BLOCKS: u32 = 10;
 
 /// Blocks taken into regions per frame, at most: the detector stops there (the
-/// segments found so far stand; the coarse pass at a [`COARSE_PX`]² share of it, as
-/// of the blocks). A real frame's segments hold up to 3 535 blocks
+/// segments found so far stand). A real frame's segments hold up to 3 535 blocks
 /// (session 55: famA, famAT, famB, famBW, fixtures A, paper A, the real Earth), its
 /// regions a few thousand more; a frame of edges everywhere (`plate-holes-2` of the
 /// worst-case set: every block an edge) would take every one of its 81 000 blocks,
@@ -125,8 +102,7 @@ pub struct Segment {
     pub dir_y: i16,
     /// Length, quarter pixels.
     pub length_q: u16,
-    /// 2×2 blocks of its region (≤ [`MAX_REGION_BLOCKS`]; of grid pixels on the coarse
-    /// pass).
+    /// 2×2 blocks of its region (≤ [`MAX_REGION_BLOCKS`]).
     pub blocks: u16,
 }
 
@@ -181,54 +157,6 @@ fn gradient(px: &[u16], width: usize, i: usize, top: u16) -> (i32, i32) {
     (b + d - a - c, c + d - a - b)
 }
 
-/// The gradient of the 2×2 block of grid pixels at (x, y)..(x + 1, y + 1) of the
-/// coarse grid (each grid pixel the sum of its [`COARSE_PX`] × [`COARSE_PX`] pixels of
-/// the `width`-wide frame, DN clamped to `top`), as [`gradient`]'s (0 off the pixels).
-#[inline(always)]
-fn coarse_gradient(px: &[u16], width: usize, x: usize, y: usize, top: u16) -> (i32, i32) {
-    let pair = |k: usize| match px.get(k..k + 2) {
-        Some(&[p, q]) => i32::from(p.min(top)) + i32::from(q.min(top)),
-        _ => 0,
-    };
-    let grid = |gx: usize, gy: usize| {
-        let k = COARSE_PX * (gy * width + gx);
-        pair(k) + pair(k + width)
-    };
-    let (a, b, c, d) = (
-        grid(x, y),
-        grid(x + 1, y),
-        grid(x, y + 1),
-        grid(x + 1, y + 1),
-    );
-    (b + d - a - c, c + d - a - b)
-}
-
-/// The two passes of the detector: on the pixels, or on the frame binned
-/// [`COARSE_PX`] × [`COARSE_PX`] ([`detect_coarse`]).
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Pass {
-    Fine,
-    Coarse,
-}
-
-impl Pass {
-    /// Pixels per grid pixel.
-    fn px(self) -> usize {
-        match self {
-            Pass::Fine => 1,
-            Pass::Coarse => COARSE_PX,
-        }
-    }
-
-    /// Least length against width ([`MIN_ELONGATION`], [`COARSE_MIN_ELONGATION`]).
-    fn min_elongation(self) -> f32 {
-        match self {
-            Pass::Fine => MIN_ELONGATION,
-            Pass::Coarse => COARSE_MIN_ELONGATION,
-        }
-    }
-}
-
 /// The running sums of a growing region.
 struct Region {
     /// Σ unit gradient directions.
@@ -263,9 +191,9 @@ impl Region {
         dot > 0.0 && dot * dot >= COS_TOLERANCE * COS_TOLERANCE * m2 * norm2
     }
 
-    /// The region as a segment (seed block at (x, y) of `pass`'s grid) in pixels, or
-    /// `None` when it is too short, too wide or too small (in grid pixels).
-    fn segment(&self, x: usize, y: usize, pass: Pass) -> Option<Segment> {
+    /// The region as a segment (seed block at (x, y)), or `None` when it is too short,
+    /// too wide or too small.
+    fn segment(&self, x: usize, y: usize) -> Option<Segment> {
         if self.n < MIN_REGION_BLOCKS {
             return None;
         }
@@ -287,17 +215,14 @@ impl Region {
         // A uniform spread over L has variance L²/12.
         let length = libm::sqrtf(12.0 * along.max(0.0));
         let width = libm::sqrtf(12.0 * across.max(0.0)).max(1.0);
-        if length < MIN_LENGTH_PX || length < pass.min_elongation() * width {
+        if length < MIN_LENGTH_PX || length < MIN_ELONGATION * width {
             return None;
         }
         // Centre: the seed plus the mean offset, plus half a pixel (the block's centre).
         let cx = x as f32 + self.dx as f32 / n + 0.5;
         let cy = y as f32 + self.dy as f32 / n + 0.5;
         let h = length / 2.0;
-        // Grid pixel g's centre lies at pixel s·g + (s − 1)/2 (s pixels per grid pixel).
-        let s = pass.px() as f32;
-        let q = |v: f32| ((s * v + (s - 1.0) / 2.0) * 4.0) as i16;
-        let length = s * length;
+        let q = |v: f32| (v * 4.0) as i16;
         Some(Segment {
             x0_q: q(cx - lx * h),
             y0_q: q(cy - ly * h),
@@ -315,39 +240,13 @@ impl Region {
 /// there are more; returns how many (≤ `out.len()`). `marks` holds one bit per pixel
 /// (cleared by [`Marks::new`]).
 pub fn detect(frame: &Frame<'_>, sigma: u32, marks: &mut Marks<'_>, out: &mut [Segment]) -> usize {
-    run(frame, sigma, marks, out, Pass::Fine)
-}
-
-/// [`detect`] on `frame` binned [`COARSE_PX`] × [`COARSE_PX`] (the sums read on the fly;
-/// a last odd column or row left out), segments at least [`MIN_LENGTH_PX`] grid pixels
-/// long and [`COARSE_MIN_ELONGATION`] times their width, in the frame's pixels.
-/// `marks` holds one bit per grid pixel (a quarter of [`detect`]'s).
-pub fn detect_coarse(
-    frame: &Frame<'_>,
-    sigma: u32,
-    marks: &mut Marks<'_>,
-    out: &mut [Segment],
-) -> usize {
-    run(frame, sigma, marks, out, Pass::Coarse)
-}
-
-/// [`detect`] or [`detect_coarse`].
-fn run(
-    frame: &Frame<'_>,
-    sigma: u32,
-    marks: &mut Marks<'_>,
-    out: &mut [Segment],
-    pass: Pass,
-) -> usize {
-    let s = pass.px();
-    let (fw, w, h) = (frame.width(), frame.width() / s, frame.height() / s);
+    let (w, h) = (frame.width(), frame.height());
     if w < 2 || h < 2 || out.is_empty() {
         return 0;
     }
     let top = frame.max_dn();
-    // Component noise 2σ (of pixels; of the s² pixels' sums, 2 s σ); thresholds on the
-    // squared magnitude.
-    let unit = 2 * s as i64 * i64::from(sigma.max(1));
+    // Component noise 2σ; thresholds on the squared magnitude.
+    let unit = 2 * i64::from(sigma.max(1));
     let edge2 = (i64::from(EDGE_SIGMAS) * unit).pow(2);
     let seed2 = (i64::from(SEED_SIGMAS) * unit).pow(2);
     let mut found = 0usize;
@@ -356,60 +255,40 @@ fn run(
     let seed_l1 = i32::try_from(i64::from(SEED_SIGMAS) * unit).unwrap_or(i32::MAX);
     let mut grower = Grower {
         px: frame.pixels(),
-        fw,
         w,
         h,
         top,
         edge2,
-        pass,
         frontier: [0u32; FRONTIER_BLOCKS],
-        // The coarse grid's share: a quarter of the blocks, a quarter of the budget.
-        left: MAX_FRAME_BLOCKS / (s * s) as u32,
-    };
-    // A seed block at (x, y) with gradient (gx, gy): its region, kept as a segment when
-    // it is one; false when the frame's blocks are spent.
-    let mut grow = |x: usize, y: usize, gx: i32, gy: i32, marks: &mut Marks<'_>| {
-        if grower.left == 0 {
-            return false;
-        }
-        let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
-        if m2 < seed2 || marks.get(y * w + x) {
-            return true;
-        }
-        let Some(s) = grower.segment_from(marks, x, y, gx, gy, m2) else {
-            return true;
-        };
-        if found < out.len() {
-            if let Some(slot) = out.get_mut(found) {
-                *slot = s;
-            }
-            found += 1;
-        } else if let Some(shortest) = out.iter_mut().min_by_key(|t| t.length_q) {
-            if shortest.length_q < s.length_q {
-                *shortest = s;
-            }
-        }
-        true
+        left: MAX_FRAME_BLOCKS,
     };
     for y in 0..h - 1 {
-        if pass == Pass::Coarse {
-            // A quarter of the blocks, each 16 reads: no carried scan.
-            for x in 0..w - 1 {
-                let (gx, gy) = coarse_gradient(frame.pixels(), fw, x, y, top);
-                if gx.abs() + gy.abs() >= seed_l1 && !grow(x, y, gx, gy, marks) {
-                    return found;
-                }
-            }
-            continue;
-        }
         let (Some(r0), Some(r1)) = (frame.row(y), frame.row(y + 1)) else {
             break;
         };
         let mut from = 0;
         while let Some((x, gx, gy)) = next_seed(r0, r1, from, top, seed_l1) {
             from = x + 1;
-            if !grow(x, y, gx, gy, marks) {
+            if grower.left == 0 {
                 return found;
+            }
+            let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
+            let i = y * w + x;
+            if m2 < seed2 || marks.get(i) {
+                continue;
+            }
+            let Some(s) = grower.segment_from(marks, x, y, gx, gy, m2) else {
+                continue;
+            };
+            if found < out.len() {
+                if let Some(slot) = out.get_mut(found) {
+                    *slot = s;
+                }
+                found += 1;
+            } else if let Some(shortest) = out.iter_mut().min_by_key(|t| t.length_q) {
+                if shortest.length_q < s.length_q {
+                    *shortest = s;
+                }
             }
         }
     }
@@ -500,17 +379,14 @@ fn next_seed(
 /// Tango frame: `auto-v2` 8.23 M → 6.68 M instructions).
 const STEP_BLOCKS: usize = 4;
 
-/// What growing a region needs: the frame (`fw` pixels wide; its grid `w` × `h` grid
-/// pixels on `pass`), the edge thresholds, the frontier and the blocks the frame's
-/// regions may still take ([`MAX_FRAME_BLOCKS`]).
+/// What growing a region needs: the frame, the edge thresholds, the frontier and the
+/// blocks the frame's regions may still take ([`MAX_FRAME_BLOCKS`]).
 struct Grower<'a> {
     px: &'a [u16],
-    fw: usize,
     w: usize,
     h: usize,
     top: u16,
     edge2: i64,
-    pass: Pass,
     frontier: [u32; FRONTIER_BLOCKS],
     left: u32,
 }
@@ -560,12 +436,7 @@ impl Grower<'_> {
                 if marks.get(q) {
                     continue;
                 }
-                let (gx, gy) = match self.pass {
-                    Pass::Fine => gradient(self.px, w, q, self.top),
-                    Pass::Coarse => {
-                        coarse_gradient(self.px, self.fw, qx as usize, qy as usize, self.top)
-                    }
-                };
+                let (gx, gy) = gradient(self.px, w, q, self.top);
                 let m2 = i64::from(gx) * i64::from(gx) + i64::from(gy) * i64::from(gy);
                 if m2 < self.edge2 {
                     // No edge: no region takes it and it seeds none (the seed
@@ -588,7 +459,7 @@ impl Grower<'_> {
                 }
             }
         }
-        region.segment(x, y, self.pass)
+        region.segment(x, y)
     }
 }
 
@@ -648,68 +519,6 @@ mod tests {
                 assert!(((y1 - y0).abs() - 40.0).abs() < 4.0, "{s:?}");
             }
         }
-    }
-
-    /// A faint rectangle (16 DN under its background, 8 σ of the noise, each side a
-    /// 3-px ramp as the optics blur it): no 2×2 block of the fine pass reaches the seed
-    /// threshold (its gradient ≤ 2 · 16 / 3 + 2 · 6 per component), so it finds none;
-    /// binned 2×2 the sides step by 10 σ of a coarse block's gradient and the coarse
-    /// pass gives the four, in the frame's pixels.
-    #[test]
-    fn a_faint_rectangle_is_found_binned() {
-        let ramp = |v: usize, lo: usize, hi: usize| {
-            let v = v as f32;
-            ((v - lo as f32 + 1.0) / 3.0).clamp(0.0, 1.0)
-                * ((hi as f32 - v + 1.0) / 3.0).clamp(0.0, 1.0)
-        };
-        let mut state = 777u32;
-        let px: std::vec::Vec<u16> = (0..W * H)
-            .map(|i| {
-                state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
-                let noise = ((state >> 16) % 7) as f32;
-                let (x, y) = (i % W, i / W);
-                (3000.0 - 16.0 * ramp(x, 30, 89) * ramp(y, 25, 64) + noise) as u16
-            })
-            .collect();
-        // Uniform noise over 0..=6: σ = 2 DN.
-        assert!(run(&px, 2).is_empty(), "{:?}", run(&px, 2));
-        let frame = Frame::new(&px, W, H, 14).unwrap();
-        let (mut lo, mut hi) = (vec![0u32; 100], vec![0u32; 0]);
-        let mut marks = Marks::new(&mut lo, &mut hi, (W / 2) * (H / 2)).unwrap();
-        let mut out = [Segment::default(); MAX_SEGMENTS];
-        let n = detect_coarse(&frame, 2, &mut marks, &mut out);
-        let segs = &out[..n];
-        assert_eq!(segs.len(), 4, "{segs:?}");
-        let mut sides = [false; 4];
-        for s in segs {
-            let (x0, y0, x1, y1) = (
-                s.x0_q as f32 / 4.0,
-                s.y0_q as f32 / 4.0,
-                s.x1_q as f32 / 4.0,
-                s.y1_q as f32 / 4.0,
-            );
-            // The middle within 1.5 px of its side, the ends within 3 px of each
-            // other across it (a grid pixel's error over 55 px: under 3° of tilt).
-            if (x1 - x0).abs() > (y1 - y0).abs() {
-                // The top ramp rises over rows 24–26, the bottom over 63–65.
-                let y = (y0 + y1) / 2.0;
-                let k = usize::from(y > 45.0);
-                assert!((y - [25.0, 64.0][k]).abs() < 1.5, "{s:?}");
-                assert!((y0 - y1).abs() < 3.0, "{s:?}");
-                assert!(((x1 - x0).abs() - 60.0).abs() < 8.0, "{s:?}");
-                assert_eq!(s.dir_y.signum(), [-1, 1][k], "outwards: {s:?}");
-                sides[k] = true;
-            } else {
-                assert!((x0 - x1).abs() < 3.0, "{s:?}");
-                let x = (x0 + x1) / 2.0;
-                let k = usize::from(x > 60.0);
-                assert!((x - [30.0, 89.0][k]).abs() < 1.5, "{s:?}");
-                assert!(((y1 - y0).abs() - 40.0).abs() < 8.0, "{s:?}");
-                assert_eq!(s.dir_x.signum(), [-1, 1][k], "outwards: {s:?}");
-                sides[2 + k] = true;
-            }
-        }
-        assert_eq!(sides, [true; 4], "{segs:?}");
     }
 
     #[test]
