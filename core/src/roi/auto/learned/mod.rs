@@ -2562,9 +2562,12 @@ impl AutoV2 {
         // (narrower than that spread: a target barely above the top DN) taken to the
         // target's half maximum around it instead (session 60).
         let erode_px = u16::from(self.saturated_erode_px);
-        let roi = roi.map(|r| match saturated::saturated_core(frame, r, erode_px) {
-            Some(around) => half_max::half_max_box(frame, around, lv.sigma, background),
-            None => saturated::saturated_box(frame, r, erode_px),
+        let roi = roi.map(|r| match saturated::saturated_target(frame, r, erode_px) {
+            saturated::Saturated::Cut(cut) => cut,
+            saturated::Saturated::Core(around) => {
+                half_max::half_max_box(frame, around, lv.sigma, background)
+            }
+            saturated::Saturated::Neither => r,
         });
         Detection {
             roi,

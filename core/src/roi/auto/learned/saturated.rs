@@ -238,17 +238,46 @@ fn is_core(hull: Roi, erode_px: u16) -> bool {
 /// per side (the kernel's reach and the pixel the halo may hold), cut to the frame;
 /// `None` otherwise ([`saturated_box`] decides). The target's outline lies in it.
 pub fn saturated_core(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Option<Roi> {
-    let hull = blob_hull(frame, roi).filter(|&h| is_core(h, erode_px))?;
-    let grow = erode_px + 1;
-    Some(
-        Roi::new(
-            hull.x0.saturating_sub(grow),
-            hull.y0.saturating_sub(grow),
-            hull.x1.saturating_add(grow),
-            hull.y1.saturating_add(grow),
-        )
-        .clip(frame.width() as u16, frame.height() as u16),
-    )
+    match saturated_target(frame, roi, erode_px) {
+        Saturated::Core(around) => Some(around),
+        _ => None,
+    }
+}
+
+/// What stage 8 makes of a box: a saturated blob's box cut back ([`saturated_box`]),
+/// a saturated core's box grown ([`saturated_core`]), or neither.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Saturated {
+    /// The blob's box cut by the optics' reach per side (off the frame's edges).
+    Cut(Roi),
+    /// The core's box grown by the reach and a pixel, cut to the frame.
+    Core(Roi),
+    /// No saturated blob (or a larger body with a saturated face): the box stands.
+    Neither,
+}
+
+/// [`saturated_box`] and [`saturated_core`] from one look at the blob (its hull and
+/// rings read once).
+pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated {
+    let Some(hull) = blob_hull(frame, roi) else {
+        return Saturated::Neither;
+    };
+    let (fw, fh) = (frame.width() as u16, frame.height() as u16);
+    if is_core(hull, erode_px) {
+        let grow = erode_px + 1;
+        return Saturated::Core(
+            Roi::new(
+                hull.x0.saturating_sub(grow),
+                hull.y0.saturating_sub(grow),
+                hull.x1.saturating_add(grow),
+                hull.y1.saturating_add(grow),
+            )
+            .clip(fw, fh),
+        );
+    }
+    let (x0, x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
+    let (y0, y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
+    Saturated::Cut(Roi { x0, y0, x1, y1 })
 }
 
 /// True when `roi` is a saturated blob and its halo ([`saturated_box`] cuts it).
@@ -264,13 +293,10 @@ pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
 /// the blob's box cut by `erode_px` per side off the frame's edges; otherwise `roi`
 /// unchanged. The result lies inside `roi`.
 pub fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
-    let Some(hull) = blob_hull(frame, roi).filter(|&h| !is_core(h, erode_px)) else {
-        return roi;
-    };
-    let (fw, fh) = (frame.width() as u16, frame.height() as u16);
-    let (x0, x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
-    let (y0, y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
-    Roi { x0, y0, x1, y1 }
+    match saturated_target(frame, roi, erode_px) {
+        Saturated::Cut(cut) => cut,
+        _ => roi,
+    }
 }
 
 #[cfg(test)]
