@@ -1744,15 +1744,11 @@ impl AutoV2 {
         } else {
             self.min_score_permille
         };
-        let d = if region_gate < self.min_score_permille {
-            AutoV2 {
-                min_score_permille: region_gate,
-                ..*self
-            }
-            .region_stages(frame, work, win, plane8, lv)
-        } else {
-            self.region_stages(frame, work, win, plane8, lv)
-        };
+        let d = AutoV2 {
+            min_score_permille: region_gate,
+            ..*self
+        }
+        .region_stages(frame, work, win, plane8, lv);
         let d = if d
             .roi
             .is_some_and(|r| r.width() < MIN_BOX_SIDE_PX || r.height() < MIN_BOX_SIDE_PX)

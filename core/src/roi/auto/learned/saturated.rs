@@ -21,8 +21,8 @@
 //! the top DN, so a blob narrower than that on a side is the *core* of a target
 //! barely above the top DN, whose outline lies beyond it (`famA/000168`: a 5×5 px
 //! target saturated on 3×2 px). Cutting it would leave a pixel (then no box at all):
-//! [`saturated_core`] gives its box instead, for the caller to take to the target's
-//! half maximum.
+//! [`saturated_target`] gives its box grown instead ([`Saturated::Core`]), for the
+//! caller to take to the target's half maximum.
 
 use crate::frame::Frame;
 use crate::roi::Roi;
@@ -232,32 +232,27 @@ fn is_core(hull: Roi, erode_px: u16) -> bool {
     hull.width() < across || hull.height() < across
 }
 
-/// The box of the saturated core of the target in `roi` (see the module): when `roi`
-/// is a saturated blob and its halo, as [`saturated_box`] asks, but the blob is
-/// narrower on a side than 2 · `erode_px` + 1 px, its box grown by `erode_px` + 1 px
-/// per side (the kernel's reach and the pixel the halo may hold), cut to the frame;
-/// `None` otherwise ([`saturated_box`] decides). The target's outline lies in it.
-pub fn saturated_core(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Option<Roi> {
-    match saturated_target(frame, roi, erode_px) {
-        Saturated::Core(around) => Some(around),
-        _ => None,
-    }
-}
-
-/// What stage 8 makes of a box: a saturated blob's box cut back ([`saturated_box`]),
-/// a saturated core's box grown ([`saturated_core`]), or neither.
+/// What stage 8 makes of a box ([`saturated_target`]): a saturated blob's box cut
+/// back, a saturated core's box grown, or neither.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Saturated {
-    /// The blob's box cut by the optics' reach per side (off the frame's edges).
+    /// The blob's box cut by the optics' reach per side (off the frame's edges); it
+    /// lies inside the box looked at.
     Cut(Roi),
-    /// The core's box grown by the reach and a pixel, cut to the frame.
+    /// The core's box grown by the reach and a pixel (the pixel the halo may hold),
+    /// cut to the frame: the target's outline lies in it.
     Core(Roi),
     /// No saturated blob (or a larger body with a saturated face): the box stands.
     Neither,
 }
 
-/// [`saturated_box`] and [`saturated_core`] from one look at the blob (its hull and
-/// rings read once).
+/// What stage 8 makes of `roi` (see the module), from one look at the blob (its hull
+/// and rings read once). When `roi` holds at least [`MIN_BLOB_PX`] pixels at the top
+/// DN, reaches at most [`PSF_RADIUS_PX`] + 1 px beyond their box on every side (it is
+/// that blob and its halo, not a larger body with a saturated face) and the target does
+/// not go on beyond the halo ([`continues_beyond`]): [`Saturated::Core`] when the blob
+/// is narrower on a side than 2 · `erode_px` + 1 px, else [`Saturated::Cut`];
+/// otherwise [`Saturated::Neither`].
 pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated {
     let Some(hull) = blob_hull(frame, roi) else {
         return Saturated::Neither;
@@ -280,23 +275,10 @@ pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated
     Saturated::Cut(Roi { x0, y0, x1, y1 })
 }
 
-/// True when `roi` is a saturated blob and its halo ([`saturated_box`] cuts it).
+/// True when `roi` is a saturated blob and its halo (stage 8 cuts or grows its box,
+/// [`saturated_target`]).
 pub fn is_saturated_blob(frame: &Frame<'_>, roi: Roi) -> bool {
     blob_hull(frame, roi).is_some()
-}
-
-/// `roi` cut to the saturated target inside it (see the module): when `roi` holds at
-/// least [`MIN_BLOB_PX`] pixels at the top DN, reaches at most
-/// [`PSF_RADIUS_PX`] + 1 px beyond their box on every side (it is that blob and its
-/// halo, not a larger body with a saturated face) and the target does not go on
-/// beyond the halo ([`continues_beyond`]), and the blob is no core ([`saturated_core`]),
-/// the blob's box cut by `erode_px` per side off the frame's edges; otherwise `roi`
-/// unchanged. The result lies inside `roi`.
-pub fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
-    match saturated_target(frame, roi, erode_px) {
-        Saturated::Cut(cut) => cut,
-        _ => roi,
-    }
 }
 
 #[cfg(test)]
@@ -304,6 +286,22 @@ mod tests {
     use super::*;
     use crate::frame::{FRAME_HEIGHT, FRAME_WIDTH};
     extern crate std;
+
+    /// The box stage 8 keeps unless it cuts it: `roi` cut, or unchanged.
+    fn saturated_box(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Roi {
+        match saturated_target(frame, roi, erode_px) {
+            Saturated::Cut(cut) => cut,
+            _ => roi,
+        }
+    }
+
+    /// The grown box of a saturated core, or `None`.
+    fn saturated_core(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Option<Roi> {
+        match saturated_target(frame, roi, erode_px) {
+            Saturated::Core(around) => Some(around),
+            _ => None,
+        }
+    }
 
     /// A brute-force reference of the blob: a sharp rectangle far above the top DN,
     /// blurred by a 5×5 box (every pixel within 2 px of a covered one saturates), is
@@ -361,9 +359,8 @@ mod tests {
     /// A target barely above the top DN (a 4×4 px face at twice the top DN over the
     /// background, blurred by the 5×5 box): only the pixels whose kernel holds at least
     /// 11 of its 16 saturate, the face less its corners, a core 4 px across, narrower
-    /// than the 8 px the kernel spreads a far hotter target to. Its box is not cut ([`saturated_box`] keeps the caller's);
-    /// [`saturated_core`] gives the core grown by the kernel's reach and a pixel, which
-    /// holds the face. Without blur (`erode_px` 0) no blob is a core; the far hotter
+    /// than the 8 px the kernel spreads a far hotter target to. Its box is not cut; it
+    /// is the core grown by the kernel's reach and a pixel, which holds the face. Without blur (`erode_px` 0) no blob is a core; the far hotter
     /// blob of the test above is none either.
     #[test]
     fn a_saturated_core_is_not_cut() {
