@@ -4,8 +4,9 @@
 //! cold body over cloud as background (session 54: `famA/000003`, 187 of its 195 cells
 //! below even odds). The frame's straight edges ([`super::segments`]) are joined into
 //! groups:
-//! - at a **corner**, two segments whose ends lie within [`CORNER_REACH_PX`] and whose
-//!   lines cross at [`MIN_CORNER_DEG`] or more, when the two edges agree on which side
+//! - at a **corner**, two segments whose ends lie within [`CORNER_REACH_PX`] (or whose
+//!   lines cross within it beyond both ends: two edges that each stop short of a
+//!   rounded corner) and whose lines cross at [`MIN_CORNER_DEG`] or more, when the two edges agree on which side
 //!   the wedge between them lies (the region inside a corner is darker, or brighter,
 //!   across both edges: two edges of one face do; a cloud edge that happens to end near
 //!   the limb's does half the time);
@@ -203,15 +204,17 @@ fn meeting(
         }
     }
     let reach_q = i64::from(CORNER_REACH_PX * 4);
-    if best.0 > reach_q * reach_q {
+    // Two corner ends each within the reach of the lines' crossing lie within twice it.
+    if best.0 > 4 * reach_q * reach_q {
         return None;
     }
+    let ends_meet = best.0 <= reach_q * reach_q;
     let (da, db) = (
         (i32::from(a.dir_x), i32::from(a.dir_y)),
         (i32::from(b.dir_x), i32::from(b.dir_y)),
     );
     let dot = i64::from(da.0 * db.0 + da.1 * db.1);
-    if dot * dot <= corner_cos2 {
+    if dot * dot <= corner_cos2 && (ends_meet || crossing_near(a, b, best.1, best.2, reach_q)) {
         // A corner: along each segment away from the meeting point, the other's
         // gradient must point to the same side (both edges bound the wedge's region).
         let (pa, oa) = (ea[best.1], ea[1 - best.1]);
@@ -224,7 +227,7 @@ fn meeting(
             i64::from(db.0) * i64::from(along_a.0) + i64::from(db.1) * i64::from(along_a.1);
         return (side_a.signum() == side_b.signum()).then_some((true, best.1, best.2));
     }
-    if dot > 0 && dot * dot >= continuation_cos2 {
+    if ends_meet && dot > 0 && dot * dot >= continuation_cos2 {
         // A continuation: b's middle near a's line (a's gradient is its normal).
         let mid = |e: [(i32, i32); 2]| (e[0].0 + e[1].0, e[0].1 + e[1].1);
         let (ma, mb) = (mid(ea), mid(eb));
@@ -235,6 +238,48 @@ fn meeting(
         return (off.abs() <= limit).then_some((false, best.1, best.2));
     }
     None
+}
+
+/// Farthest an edge's segment may run past the corner it meets, pixels: a segment's
+/// ends are read within a pixel of the edge's; the optics round a corner, so an edge
+/// stops short of it, never beyond.
+pub const CORNER_OVERSHOOT_PX: i32 = 1;
+
+/// Whether the lines of `a` and `b` (not parallel) cross beyond a's end `end_a` and b's
+/// end `end_b`, within `reach_q` quarter pixels of each along its line (or
+/// [`CORNER_OVERSHOOT_PX`] before it): the optics round a corner, so each edge's segment
+/// stops short of it by up to the reach, and two ends short by 5 px each at a right
+/// angle lie 7 px apart though the corner is plain (`famAT/000233`, a 30-px panel's
+/// corner at the border). An edge that runs on past the other's line (a texture edge
+/// crossing the limb) makes no corner.
+fn crossing_near(a: &Segment, b: &Segment, end_a: usize, end_b: usize, reach_q: i64) -> bool {
+    let (ea, eb) = (ends(a), ends(b));
+    let (pa, oa, pb, ob) = (ea[end_a], ea[1 - end_a], eb[end_b], eb[1 - end_b]);
+    let (na, nb) = (
+        (i64::from(a.dir_x), i64::from(a.dir_y)),
+        (i64::from(b.dir_x), i64::from(b.dir_y)),
+    );
+    // With normals n and directions u = (−n_y, n_x), the lines cross at pa + t·u_a,
+    // t = ((pb − pa)·n_b) / (u_a·n_b), and at pb + s·u_b, s = ((pa − pb)·n_a) / (u_b·n_a);
+    // u_a·n_b = det and u_b·n_a = −det (n in DIRECTION_ONE units: t = num · DIRECTION_ONE
+    // / det quarter pixels). Each is signed outwards (from the segment's other end).
+    let det = na.0 * nb.1 - na.1 * nb.0;
+    if det == 0 {
+        return false;
+    }
+    let outward = |p: (i32, i32), o: (i32, i32), n: (i64, i64)| {
+        (-i64::from(p.0 - o.0) * n.1 + i64::from(p.1 - o.1) * n.0).signum()
+    };
+    let (dx, dy) = (i64::from(pb.0 - pa.0), i64::from(pb.1 - pa.1));
+    let one = i64::from(DIRECTION_ONE);
+    // t·|det| and s·|det|, outwards.
+    let t = (dx * nb.0 + dy * nb.1) * one * outward(pa, oa, na) * det.signum();
+    let s = (dx * na.0 + dy * na.1) * one * outward(pb, ob, nb) * det.signum();
+    let (lo, hi) = (
+        -i64::from(CORNER_OVERSHOOT_PX * 4) * det.abs(),
+        reach_q * det.abs(),
+    );
+    (lo..=hi).contains(&t) && (lo..=hi).contains(&s)
 }
 
 /// A group's sums: its segments' summed length, count, corners and the box of their
@@ -602,6 +647,40 @@ mod tests {
         let tip_a = seg(110.0, 0.0, 110.0, 10.0, -1.0, 0.0);
         let tip_b = seg(111.5, 11.5, 119.0, 11.5, 0.0, 1.0);
         assert!(strongest(&[tip_a, tip_b], 120, 90).is_none());
+    }
+
+    #[test]
+    fn edges_that_stop_short_of_their_crossing_meet_at_a_corner() {
+        // The panel's corner of the test above, each edge 5 px short of (100, 18): the
+        // ends lie 7.1 px apart, beyond CORNER_REACH_PX, but the lines cross within it
+        // of both, beyond each end.
+        let left = seg(100.0, 0.0, 100.0, 13.0, -1.0, 0.0);
+        let bottom = seg(105.0, 18.0, 119.0, 18.0, 0.0, 1.0);
+        let o = strongest(&[left, bottom], 120, 90).unwrap();
+        assert_eq!((o.segments, o.corners), (2, 1), "{o:?}");
+        assert!(o.closed_by_border);
+        assert_eq!(
+            o.roi,
+            Roi {
+                x0: 100,
+                y0: 0,
+                x1: 120,
+                y1: 18
+            }
+        );
+        // Short by 7 px each: the crossing is out of reach.
+        let far_left = seg(100.0, 0.0, 100.0, 11.0, -1.0, 0.0);
+        let far_bottom = seg(107.0, 18.0, 119.0, 18.0, 0.0, 1.0);
+        assert!(strongest(&[far_left, far_bottom], 120, 90).is_none());
+        // An edge running 3 px past the other's line (a texture edge across the
+        // limb), ends 6.3 px apart: no corner.
+        let through = seg(100.0, 0.0, 100.0, 21.0, -1.0, 0.0);
+        let beside = seg(105.5, 18.0, 119.0, 18.0, 0.0, 1.0);
+        assert!(strongest(&[through, beside], 120, 90).is_none());
+        // Run 1 px past it (a segment's end read a pixel off): still a corner.
+        let reaching = seg(100.0, 0.0, 100.0, 19.0, -1.0, 0.0);
+        let o = strongest(&[reaching, beside], 120, 90).unwrap();
+        assert_eq!(o.corners, 1, "{o:?}");
     }
 
     #[test]
