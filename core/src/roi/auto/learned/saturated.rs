@@ -9,6 +9,11 @@
 //! family-A renders (`AutoV2::saturated_erode_px`); a side on the frame's edge is
 //! kept (the target goes on beyond it).
 //!
+//! The cut box is the box of the pixels the target covers at all; the truth counts only
+//! those it covers half. Where the target meets the box's outermost line with a
+//! corner's tip (one or two covered pixels: a target turned at an angle), that line is
+//! rarely half covered and is cut too ([`TIP_MAX_PX`], session 61).
+//!
 //! Only a target saturated *whole* is its blob: a hot face of a larger body saturates
 //! too, with the body's cooler faces beyond the halo (session 47: on family A's
 //! radiometry frames such a face was cut to a 1×1 … 13×17 px box of a 5×4 … 24×27 px
@@ -61,6 +66,72 @@ pub const DEPART_SPREAD_FACTOR: u64 = 4;
 /// 0–5 % — the 5 % one sprinkle of noise on 0 DN deep space — and hot faces of a
 /// larger body 12–42 %).
 pub const DEPART_SHARE_DIVISOR: u64 = 10;
+
+/// Most pixels of the covered set's outermost line (see [`saturated_target`]) that make
+/// it a corner's tip, cut one pixel more. A target far above the top DN saturates every
+/// pixel within the kernel's reach of a pixel it covers at all, so the blob eroded by
+/// the kernel's square is the set of pixels the target covers at all, and the cut box
+/// is that set's box. The truth counts a pixel only when the target covers half of it:
+/// along an edge square to the frame's axes the outermost line's pixels are covered by
+/// the same share (in the truth half the time, the cut's coin toss), but a target turned
+/// at an angle reaches the outermost line with a corner's tip, one or two pixels
+/// covered by a small triangle, rarely half. A line shorter than twice this many
+/// pixels has no tip to tell from an edge, and a cut never leaves a side under
+/// [`super::MIN_BOX_SIDE_PX`] + 1 px (a 3-px box cut to 1 px would be no target).
+/// Chosen on family A (session 61): a Python replay on famA's cut boxes, 1 / **2** / 3
+/// px → mean IoU +0.012 / **+0.028** / +0.003 (3 px is the whole edge of the smallest
+/// far targets), any side (one pixel more on every side) −0.014; in the detector, with
+/// the short-line and 3-px rules, famA +0.0295 (detection far 0.729 → 0.823), famAF
+/// −0.0004, paper A and fixtures A unchanged, famAT −0.0037 (Tango's boxes are already
+/// short of its booms); held out famB +0.0338, famBW +0.0300, famBT −0.0021.
+pub const TIP_MAX_PX: u32 = 2;
+
+/// Pixels of the line `fixed` (a column when `vertical`, else a row) from `from` to
+/// `to` (exclusive) whose (2 `erode_px` + 1)² square lies wholly at the top DN (off the
+/// frame counting as at it): the pixels the target covers at all, in that line of the
+/// cut box. Counts at most `limit` + 1.
+fn covered_in_line(
+    frame: &Frame<'_>,
+    fixed: u16,
+    (from, to): (u16, u16),
+    vertical: bool,
+    erode_px: u16,
+    limit: u32,
+) -> u32 {
+    let top = frame.max_dn();
+    let (fw, fh) = (frame.width() as i32, frame.height() as i32);
+    let e = i32::from(erode_px);
+    let saturated = |x: i32, y: i32| {
+        if x < 0 || y < 0 || x >= fw || y >= fh {
+            return true;
+        }
+        frame
+            .row(y as usize)
+            .and_then(|r| r.get(x as usize))
+            .is_some_and(|&v| v >= top)
+    };
+    // Along the line, each position's cross-section (2e + 1 px across it) saturated;
+    // a pixel is covered when 2e + 1 consecutive cross-sections are.
+    let fixed = i32::from(fixed);
+    let (mut run, mut count) = (0i32, 0u32);
+    for p in i32::from(from) - e..i32::from(to) + e {
+        let whole = (-e..=e).all(|d| {
+            if vertical {
+                saturated(fixed + d, p)
+            } else {
+                saturated(p, fixed + d)
+            }
+        });
+        run = if whole { run + 1 } else { 0 };
+        if p >= i32::from(from) + e && run > 2 * e {
+            count += 1;
+            if count > limit {
+                break;
+            }
+        }
+    }
+    count
+}
 
 /// Calls `f` with every pixel value at Chebyshev distance `from..=to` px (`from` ≥ 1)
 /// from `hull`, inside the frame and at least `margin` px from its edges.
@@ -270,8 +341,33 @@ pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated
             .clip(fw, fh),
         );
     }
-    let (x0, x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
-    let (y0, y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
+    let (mut x0, mut x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
+    let (mut y0, mut y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
+    // A side whose outermost covered line is a corner's tip: one pixel more (keeping
+    // at least 1 px, and every side on the frame's edge).
+    if erode_px > 0 {
+        let tip = |fixed: u16, span: (u16, u16), vertical: bool| {
+            u32::from(span.1 - span.0) >= 2 * TIP_MAX_PX
+                && covered_in_line(frame, fixed, span, vertical, erode_px, TIP_MAX_PX) <= TIP_MAX_PX
+        };
+        let (left, right) = (
+            hull.x0 > 0 && tip(x0, (y0, y1), true),
+            hull.x1 < fw && tip(x1.saturating_sub(1), (y0, y1), true),
+        );
+        let (upper, lower) = (
+            hull.y0 > 0 && tip(y0, (x0, x1), false),
+            hull.y1 < fh && tip(y1.saturating_sub(1), (x0, x1), false),
+        );
+        let keep = super::MIN_BOX_SIDE_PX + 1;
+        if x1 - x0 >= keep + u16::from(left) + u16::from(right) {
+            x0 += u16::from(left);
+            x1 -= u16::from(right);
+        }
+        if y1 - y0 >= keep + u16::from(upper) + u16::from(lower) {
+            y0 += u16::from(upper);
+            y1 -= u16::from(lower);
+        }
+    }
     Saturated::Cut(Roi { x0, y0, x1, y1 })
 }
 
@@ -354,6 +450,94 @@ mod tests {
         let flat = std::vec![700u16; FRAME_WIDTH * FRAME_HEIGHT];
         let frame = Frame::new(&flat, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
         assert_eq!(saturated_box(&frame, found, 2), found);
+    }
+
+    /// A square face far above the top DN, turned by `deg`, centred at (`cx`, `cy`) px
+    /// with sides of `side_px`: each pixel's covered share (16 × 16 samples), the frame
+    /// of the blob (every pixel within 2 px of one covered at all is at the top DN) and
+    /// the truth box (pixels at least half covered).
+    fn turned_square(cx: f64, cy: f64, side_px: f64, deg: f64) -> (std::vec::Vec<u16>, Roi) {
+        let (s, c) = (deg.to_radians().sin(), deg.to_radians().cos());
+        let inside = |x: f64, y: f64| {
+            let (dx, dy) = (x - cx, y - cy);
+            (dx * c + dy * s).abs() <= side_px / 2.0 && (-dx * s + dy * c).abs() <= side_px / 2.0
+        };
+        let (w, h) = (FRAME_WIDTH, FRAME_HEIGHT);
+        let mut share = std::vec![0u32; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                if ((x as f64 + 0.5) - cx).abs() > side_px
+                    || ((y as f64 + 0.5) - cy).abs() > side_px
+                {
+                    continue;
+                }
+                share[y * w + x] = (0..256)
+                    .filter(|k| {
+                        let (sx, sy) = ((k % 16) as f64 + 0.5, (k / 16) as f64 + 0.5);
+                        inside(x as f64 + sx / 16.0, y as f64 + sy / 16.0)
+                    })
+                    .count() as u32;
+            }
+        }
+        let mut px = std::vec![700u16; w * h];
+        let mut truth = Roi::EMPTY;
+        for y in 0..h {
+            for x in 0..w {
+                if share[y * w + x] >= 128 {
+                    let p = Roi::pixel(x as u16, y as u16);
+                    truth = truth.hull(&p);
+                }
+                let near = (y.saturating_sub(2)..(y + 3).min(h)).any(|yy| {
+                    (x.saturating_sub(2)..(x + 3).min(w)).any(|xx| share[yy * w + xx] > 0)
+                });
+                if near {
+                    px[y * w + x] = 4095;
+                }
+            }
+        }
+        (px, truth)
+    }
+
+    /// A face turned at an angle reaches the outermost line of the pixels it covers
+    /// with a corner's tip, under half covered: that side is cut one pixel more, and
+    /// the box is the truth's at 30° and 45° (brute force: the face's exact pixel
+    /// shares), nearer it at 20°. Square to the axes, with its edges on pixel
+    /// boundaries, it is cut by the reach alone.
+    #[test]
+    fn a_turned_face_is_cut_past_its_corners_tips() {
+        for (deg, cx, cy) in [
+            (30.0, 150.3, 100.6),
+            (45.0, 150.5, 100.5),
+            (20.0, 80.2, 60.7),
+        ] {
+            let (px, truth) = turned_square(cx, cy, 7.0, deg);
+            let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
+            let found = Roi::new(truth.x0 - 5, truth.y0 - 5, truth.x1 + 5, truth.y1 + 5);
+            let (hull, _) = saturated_hull(&frame, found);
+            let plain = Roi {
+                x0: hull.x0 + 2,
+                y0: hull.y0 + 2,
+                x1: hull.x1 - 2,
+                y1: hull.y1 - 2,
+            };
+            let got = saturated_box(&frame, hull, PSF_RADIUS_PX);
+            assert_ne!(plain, truth, "{deg}°: the plain cut should miss");
+            if deg >= 30.0 {
+                assert_eq!(got, truth, "{deg}°: plain cut {plain:?}");
+            } else {
+                // At 20° a tip spans three pixels of the line on one side: that side
+                // keeps the plain cut, the others are the truth's.
+                assert!(
+                    got.iou(&truth) > plain.iou(&truth),
+                    "{deg}°: {got:?} {truth:?}"
+                );
+            }
+        }
+        // Square to the axes on pixel boundaries: the outermost lines are whole edges.
+        let (px, truth) = turned_square(150.0, 100.0, 8.0, 0.0);
+        let frame = Frame::new(&px, FRAME_WIDTH, FRAME_HEIGHT, 12).unwrap();
+        let found = Roi::new(truth.x0 - 3, truth.y0 - 3, truth.x1 + 3, truth.y1 + 3);
+        assert_eq!(saturated_box(&frame, found, PSF_RADIUS_PX), truth);
     }
 
     /// A target barely above the top DN (a 4×4 px face at twice the top DN over the
