@@ -463,13 +463,18 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
             b.merge(&g);
         }
     }
-    // Pixels whose centres lie inside the ends' box (an edge lies between two pixels).
-    // (`max`/`min`, not `clamp`, whose bounds check is a panic path.)
+    // Pixels whose centres lie inside the ends' box (an edge lies between two pixels):
+    // from the first centre at or after the low end to the last at or before the high
+    // end, the box's end one past it. (`max`/`min`, not `clamp`, whose bounds check is
+    // a panic path.)
     let last = |n: usize| n.saturating_sub(1).min(usize::from(u16::MAX)) as i32;
     let lo = |q: i16, n: usize| (i32::from(q) + 3).div_euclid(4).max(0).min(last(n)) as u16;
     let hi = |q: i16, n: usize| i32::from(q).div_euclid(4).max(0).min(last(n)) as u16;
     let (mut x0, mut y0) = (lo(b.x0_q, width), lo(b.y0_q, height));
-    let (mut x1, mut y1) = (hi(b.x1_q, width).max(x0), hi(b.y1_q, height).max(y0));
+    let (mut x1, mut y1) = (
+        hi(b.x1_q, width).max(x0) + 1,
+        hi(b.y1_q, height).max(y0) + 1,
+    );
     let closed = closed_by_border(&best);
     if closed {
         // The piece runs on to the border its free ends reach.
@@ -537,8 +542,8 @@ mod tests {
             Roi {
                 x0: 30,
                 y0: 25,
-                x1: 89,
-                y1: 64
+                x1: 90,
+                y1: 65
             }
         );
         assert_eq!(o.score_permille(), MANY_CORNERS_SCORE_PERMILLE);
@@ -568,8 +573,8 @@ mod tests {
             Roi {
                 x0: 30,
                 y0: 25,
-                x1: 119,
-                y1: 64
+                x1: 120,
+                y1: 65
             }
         );
         // Apart by more than the reach, the part stays out.
@@ -587,8 +592,8 @@ mod tests {
             Roi {
                 x0: 30,
                 y0: 25,
-                x1: 89,
-                y1: 64
+                x1: 90,
+                y1: 65
             }
         );
     }
@@ -616,10 +621,11 @@ mod tests {
     #[test]
     fn a_piece_cut_by_the_frame_is_closed_by_its_border() {
         // A dark panel's corner in the frame's top-right corner (120 × 90): two edges of
-        // 20 and 16 px meeting at (100, 18), their free ends on the top and right sides.
+        // 16 and 18 px meeting at (99.5, 17.5) (between pixels), their free ends on the
+        // top and right sides.
         // The panel lies between them and the frame's corner (gradients point out of it).
-        let left = seg(100.0, 0.0, 100.0, 16.5, -1.0, 0.0);
-        let bottom = seg(101.5, 18.0, 119.0, 18.0, 0.0, 1.0);
+        let left = seg(99.5, 0.0, 99.5, 16.0, -1.0, 0.0);
+        let bottom = seg(101.0, 17.5, 119.0, 17.5, 0.0, 1.0);
         let o = strongest(&[left, bottom], 120, 90).unwrap();
         assert!(o.closed_by_border, "{o:?}");
         assert_eq!((o.segments, o.corners), (2, 1));
@@ -637,9 +643,9 @@ mod tests {
         );
         // The same corner with a free end 12 or 9 px inside the frame is open: under
         // MIN_OUTLINE_PX, no outline.
-        let short_bottom = seg(101.5, 18.0, 107.0, 18.0, 0.0, 1.0);
+        let short_bottom = seg(101.0, 17.5, 106.5, 17.5, 0.0, 1.0);
         assert!(strongest(&[left, short_bottom], 120, 90).is_none());
-        let inner = seg(101.5, 18.0, 110.0, 18.0, 0.0, 1.0);
+        let inner = seg(101.0, 17.5, 109.5, 17.5, 0.0, 1.0);
         let o = strongest(&[left, inner], 120, 90);
         assert!(o.is_none(), "{o:?}");
         // Closed by the border but under MIN_BORDER_OUTLINE_PX in total (a cloud's
@@ -651,11 +657,11 @@ mod tests {
 
     #[test]
     fn edges_that_stop_short_of_their_crossing_meet_at_a_corner() {
-        // The panel's corner of the test above, each edge 5 px short of (100, 18): the
+        // The panel's corner of the test above, each edge 5 px short of (99.5, 17.5): the
         // ends lie 7.1 px apart, beyond CORNER_REACH_PX, but the lines cross within it
         // of both, beyond each end.
-        let left = seg(100.0, 0.0, 100.0, 13.0, -1.0, 0.0);
-        let bottom = seg(105.0, 18.0, 119.0, 18.0, 0.0, 1.0);
+        let left = seg(99.5, 0.0, 99.5, 12.5, -1.0, 0.0);
+        let bottom = seg(104.5, 17.5, 119.0, 17.5, 0.0, 1.0);
         let o = strongest(&[left, bottom], 120, 90).unwrap();
         assert_eq!((o.segments, o.corners), (2, 1), "{o:?}");
         assert!(o.closed_by_border);
@@ -669,16 +675,16 @@ mod tests {
             }
         );
         // Short by 7 px each: the crossing is out of reach.
-        let far_left = seg(100.0, 0.0, 100.0, 11.0, -1.0, 0.0);
-        let far_bottom = seg(107.0, 18.0, 119.0, 18.0, 0.0, 1.0);
+        let far_left = seg(99.5, 0.0, 99.5, 10.5, -1.0, 0.0);
+        let far_bottom = seg(106.5, 17.5, 119.0, 17.5, 0.0, 1.0);
         assert!(strongest(&[far_left, far_bottom], 120, 90).is_none());
         // An edge running 3 px past the other's line (a texture edge across the
         // limb), ends 6.3 px apart: no corner.
-        let through = seg(100.0, 0.0, 100.0, 21.0, -1.0, 0.0);
-        let beside = seg(105.5, 18.0, 119.0, 18.0, 0.0, 1.0);
+        let through = seg(99.5, 0.0, 99.5, 20.5, -1.0, 0.0);
+        let beside = seg(105.0, 17.5, 119.0, 17.5, 0.0, 1.0);
         assert!(strongest(&[through, beside], 120, 90).is_none());
         // Run 1 px past it (a segment's end read a pixel off): still a corner.
-        let reaching = seg(100.0, 0.0, 100.0, 19.0, -1.0, 0.0);
+        let reaching = seg(99.5, 0.0, 99.5, 18.5, -1.0, 0.0);
         let o = strongest(&[reaching, beside], 120, 90).unwrap();
         assert_eq!(o.corners, 1, "{o:?}");
     }
@@ -693,7 +699,7 @@ mod tests {
         assert_eq!(o.roi.x1, 90);
         let o = strongest(&[top, bottom, left], 120, 90).unwrap();
         assert!(!o.closed_by_border, "{o:?}");
-        assert_eq!(o.roi.x1, 88);
+        assert_eq!(o.roi.x1, 89);
     }
 
     #[test]
@@ -708,13 +714,13 @@ mod tests {
         let along = seg(91.0, 40.0, 115.0, 40.0, 0.0, -1.0);
         let o = strongest(&with(along), 160, 90).unwrap();
         assert_eq!((o.segments, o.corners), (4, 4), "{o:?}");
-        assert_eq!(o.roi.x1, 115);
+        assert_eq!(o.roi.x1, 116);
         let upright = seg(91.0, 30.0, 91.0, 55.0, 1.0, 0.0);
-        assert_eq!(strongest(&with(upright), 160, 90).unwrap().roi.x1, 91);
+        assert_eq!(strongest(&with(upright), 160, 90).unwrap().roi.x1, 92);
         let skew = seg(91.0, 40.0, 108.0, 57.0, 1.0, -1.0);
-        assert_eq!(strongest(&with(skew), 160, 90).unwrap().roi.x1, 89);
+        assert_eq!(strongest(&with(skew), 160, 90).unwrap().roi.x1, 90);
         let far = seg(99.0, 40.0, 120.0, 40.0, 0.0, -1.0);
-        assert_eq!(strongest(&with(far), 160, 90).unwrap().roi.x1, 89);
+        assert_eq!(strongest(&with(far), 160, 90).unwrap().roi.x1, 90);
     }
 
     #[test]
