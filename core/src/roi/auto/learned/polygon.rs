@@ -136,6 +136,11 @@ pub const BORDER_OUTLINE_SCORE_PERMILLE: u16 = FEW_CORNERS_SCORE_PERMILLE;
 /// tolerance as a continuation's ([`MAX_CONTINUATION_DEG`]).
 pub const MAX_PART_SQUARE_DEG: f32 = MAX_CONTINUATION_DEG;
 
+/// A segment's end within this many quarter pixels of the frame's outermost pixel
+/// centres (1 px) lies at the border: the 2×2 blocks nearest it are centred half a
+/// pixel inside, and a segment's end is read from its blocks' spread.
+pub const BORDER_END_Q: i32 = 4;
+
 /// The outline the stage found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Outline {
@@ -458,9 +463,16 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
         dot2 >= square_cos2 || dot2 <= perpendicular_cos2
     };
     let mut b = best;
+    // The groups the box takes (by root label).
+    let mut taken = [false; MAX_SEGMENTS];
     for (l, g) in roots() {
-        if best.reaches(&g, reach_q) && (g.corners > 0 || square(l)) {
-            b.merge(&g);
+        if l == best_root || (best.reaches(&g, reach_q) && (g.corners > 0 || square(l))) {
+            if l != best_root {
+                b.merge(&g);
+            }
+            if let Some(t) = taken.get_mut(l) {
+                *t = true;
+            }
         }
     }
     // Pixels whose centres lie inside the ends' box (an edge lies between two pixels):
@@ -475,6 +487,35 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
         hi(b.x1_q, width).max(x0) + 1,
         hi(b.y1_q, height).max(y0) + 1,
     );
+    // An edge that runs into the frame's border (more across it than along) and ends
+    // at it goes on beyond: the 2×2 blocks end half a pixel inside, so its segment
+    // stops there and the box one pixel short of the border.
+    let (w_q, h_q) = (width as i32 * 4, height as i32 * 4);
+    let at = BORDER_END_Q;
+    for (i, s) in segments.iter().enumerate() {
+        if !taken
+            .get(usize::from(groups.find(i as u8)))
+            .copied()
+            .unwrap_or(false)
+        {
+            continue;
+        }
+        let across_x = i32::from(s.dir_x).abs() < i32::from(s.dir_y).abs();
+        for (x, y) in ends(s) {
+            if across_x && x <= at {
+                x0 = 0;
+            }
+            if across_x && x >= w_q - 2 - at {
+                x1 = last(width) as u16 + 1;
+            }
+            if !across_x && y <= at {
+                y0 = 0;
+            }
+            if !across_x && y >= h_q - 2 - at {
+                y1 = last(height) as u16 + 1;
+            }
+        }
+    }
     let closed = closed_by_border(&best);
     if closed {
         // The piece runs on to the border its free ends reach.
@@ -687,6 +728,24 @@ mod tests {
         let reaching = seg(99.5, 0.0, 99.5, 18.5, -1.0, 0.0);
         let o = strongest(&[reaching, beside], 120, 90).unwrap();
         assert_eq!(o.corners, 1, "{o:?}");
+    }
+
+    #[test]
+    fn an_edge_running_into_the_border_carries_the_box_to_it() {
+        // A dark face cut by the left border: its top edge runs into the border (its
+        // last blocks' centres half a pixel inside), its right side ends open at the
+        // bottom (not closed by the border). The box reaches column 0.
+        let top = seg(0.5, 24.5, 60.0, 24.5, 0.0, -1.0);
+        let right = seg(61.5, 26.0, 61.5, 63.0, 1.0, 0.0);
+        let o = strongest(&[top, right], 120, 90).unwrap();
+        assert!(!o.closed_by_border, "{o:?}");
+        assert_eq!(o.roi.x0, 0, "{o:?}");
+        // An edge along the border (a vertical side at x 0.5, the face starting at
+        // column 1) does not: the box starts at column 1.
+        let left = seg(0.5, 26.0, 0.5, 63.0, -1.0, 0.0);
+        let top = seg(2.0, 24.5, 60.0, 24.5, 0.0, -1.0);
+        let o = strongest(&[left, top, right], 120, 90).unwrap();
+        assert_eq!(o.roi.x0, 1, "{o:?}");
     }
 
     #[test]
