@@ -210,17 +210,22 @@ fn far_ring_level(frame: &Frame<'_>, hull: Roi) -> Option<(u64, u64)> {
 /// Such a blob is taken to its half maximum instead, as a core is (session 61), when
 /// its cut leaves a box ([`super::MIN_BOX_SIDE_PX`] a side). Chosen on family A (seeds
 /// 7001–7201, ½ convention; a Python replay put the share's split at ⅛–⅖ alike): famA
-/// +0.0007, famAT +0.0155, no set lower, no false alarm added; held out famBT +0.0117,
-/// famBW +0.0033, famB +0.0010. Without the "cut leaves a box" condition famA and famAF
+/// +0.0004, famAT +0.0155, no false alarm added; held out famBT +0.0117, famBW +0.0032,
+/// famB +0.0013. (Read from every pixel beside a saturated one, holes included, famA
+/// +0.0007, but the pass over the blob's whole box cost the flight demo's detection
+/// frame, a large saturated plate, 0.2 M instructions.) Without the "cut leaves a box" condition famA and famAF
 /// gain +0.0036 more, but the Moon's disc (a few pixels just above the top DN, which
 /// the cut reduced to a pixel and dropped) is boxed on two of family A's frames without
 /// a target (`famA/000084`, `famAT/000138`): the Moon is then a false alarm as any
 /// saturated blob is, a limit left to a rule that knows it (its direction).
 pub const HALO_SHARE_DIV: u64 = 4;
 
-/// True when the saturated blob of box `hull` has a halo (see [`HALO_SHARE_DIV`]):
-/// one pass over the box grown by a pixel, each horizontal and vertical pair of
-/// pixels of which one is at the top DN adding the other's DN.
+/// True when the saturated blob of box `hull` has a halo (see [`HALO_SHARE_DIV`]): the
+/// pixels just outside its outline, met from each side of its box — on every row the
+/// pixel before its first and after its last pixel at the top DN, on every column the
+/// pixel above and below — their mean against the surroundings' level. Each scan stops
+/// at the blob, so a solid blob costs about its box's perimeter, not its area (a large
+/// saturated plate: the flight demo's detection frame).
 fn has_halo(frame: &Frame<'_>, hull: Roi) -> bool {
     let Some((level, _)) = far_ring_level(frame, hull) else {
         return false;
@@ -229,34 +234,37 @@ fn has_halo(frame: &Frame<'_>, hull: Roi) -> bool {
     if level >= u64::from(top) {
         return false;
     }
-    let (fw, fh) = (frame.width(), frame.height());
-    let x0 = usize::from(hull.x0).saturating_sub(1);
-    let x1 = (usize::from(hull.x1) + 1).min(fw);
-    let y0 = usize::from(hull.y0).saturating_sub(1);
-    let y1 = (usize::from(hull.y1) + 1).min(fh);
+    let (x0, x1) = (usize::from(hull.x0), usize::from(hull.x1));
+    let (y0, y1) = (usize::from(hull.y0), usize::from(hull.y1));
+    let at = |x: usize, y: usize| frame.row(y).and_then(|r| r.get(x)).copied();
     let (mut sum, mut n) = (0u64, 0u64);
-    let mut add = |a: u16, b: u16| {
-        if (a >= top) != (b >= top) {
-            sum += u64::from(a.min(b));
+    let mut add = |v: Option<u16>| {
+        if let Some(v) = v {
+            sum += u64::from(v);
             n += 1;
         }
     };
-    let mut prev: Option<&[u16]> = None;
     for y in y0..y1 {
         let Some(row) = frame.row(y).and_then(|r| r.get(x0..x1)) else {
             continue;
         };
-        for pair in row.windows(2) {
-            if let [a, b] = *pair {
-                add(a, b);
-            }
-        }
-        if let Some(p) = prev {
-            for (&a, &b) in p.iter().zip(row) {
-                add(a, b);
-            }
-        }
-        prev = Some(row);
+        let Some(first) = row.iter().position(|&v| v >= top) else {
+            continue;
+        };
+        let last = row.iter().rposition(|&v| v >= top).unwrap_or(first);
+        add((x0 + first).checked_sub(1).and_then(|x| at(x, y)));
+        add(at(x0 + last + 1, y));
+    }
+    for x in x0..x1 {
+        let Some(first) = (y0..y1).find(|&y| at(x, y).is_some_and(|v| v >= top)) else {
+            continue;
+        };
+        let last = (y0..y1)
+            .rev()
+            .find(|&y| at(x, y).is_some_and(|v| v >= top))
+            .unwrap_or(first);
+        add(first.checked_sub(1).and_then(|y| at(x, y)));
+        add(at(x, last + 1));
     }
     n > 0 && (sum / n).saturating_sub(level) * HALO_SHARE_DIV >= u64::from(top) - level
 }
