@@ -196,7 +196,7 @@ fn far_ring_level(frame: &Frame<'_>, hull: Roi) -> Option<(u64, u64)> {
         sum += u64::from(v);
         n += 1;
     });
-    (n > 0).then(|| (sum / n, n))
+    sum.checked_div(n).map(|level| (level, n))
 }
 
 /// A blob has a halo when the pixels beside it (not at the top DN, 4-adjacent to one
@@ -266,7 +266,9 @@ fn has_halo(frame: &Frame<'_>, hull: Roi) -> bool {
         add(first.checked_sub(1).and_then(|y| at(x, y)));
         add(at(x, last + 1));
     }
-    n > 0 && (sum / n).saturating_sub(level) * HALO_SHARE_DIV >= u64::from(top) - level
+    sum.checked_div(n).is_some_and(|mean| {
+        mean.saturating_sub(level) * HALO_SHARE_DIV >= u64::from(top).saturating_sub(level)
+    })
 }
 
 /// True when the target goes on beyond the saturated blob `hull` (the blob's box):
@@ -288,7 +290,8 @@ pub fn continues_beyond(frame: &Frame<'_>, hull: Roi) -> bool {
     for_each_ring_px(frame, hull, far.0, far.1, 0, |v| {
         deviation += u64::from(v).abs_diff(level);
     });
-    let limit = DEPART_SPREAD_FACTOR * (deviation / n).max(1);
+    // (`checked_div`: `n` > 0, but not provably so here: no panic path.)
+    let limit = DEPART_SPREAD_FACTOR * deviation.checked_div(n).unwrap_or(0).max(1);
     let (mut near_px, mut departing) = (0u64, 0u64);
     for_each_ring_px(frame, hull, near.0, near.1, usize::from(RING_PX), |v| {
         near_px += 1;
