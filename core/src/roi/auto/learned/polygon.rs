@@ -708,12 +708,8 @@ mod tests {
         assert!(o.closed_by_border);
         assert_eq!(
             o.roi,
-            Roi {
-                x0: 100,
-                y0: 0,
-                x1: 120,
-                y1: 18
-            }
+            Roi::new(100, 0, 120, 18),
+            "the same box as the test above's"
         );
         // Short by 7 px each: the crossing is out of reach.
         let far_left = seg(99.5, 0.0, 99.5, 10.5, -1.0, 0.0);
