@@ -6,7 +6,8 @@
 //! groups:
 //! - at a **corner**, two segments whose ends lie within [`CORNER_REACH_PX`] (or whose
 //!   lines cross within it beyond both ends: two edges that each stop short of a
-//!   rounded corner) and whose lines cross at [`MIN_CORNER_DEG`] or more, when the two edges agree on which side
+//!   rounded corner) and whose lines cross at [`MIN_CORNER_DEG`] or more, when the two
+//!   edges agree on which side
 //!   the wedge between them lies (the region inside a corner is darker, or brighter,
 //!   across both edges: two edges of one face do; a cloud edge that happens to end near
 //!   the limb's does half the time);
@@ -287,6 +288,16 @@ fn crossing_near(a: &Segment, b: &Segment, end_a: usize, end_b: usize, reach_q: 
     (lo..=hi).contains(&t) && (lo..=hi).contains(&s)
 }
 
+/// The sides of a `w_q` × `h_q` frame (quarter pixels) that point (`x`, `y`) lies
+/// within `reach_q` of, measured from the outermost pixel centres: bits left, top,
+/// right, bottom.
+fn border_sides(x: i32, y: i32, reach_q: i32, (w_q, h_q): (i32, i32)) -> u8 {
+    u8::from(x <= reach_q)
+        | u8::from(y <= reach_q) << 1
+        | u8::from(x >= w_q - 4 - reach_q) << 2
+        | u8::from(y >= h_q - 4 - reach_q) << 3
+}
+
 /// A group's sums: its segments' summed length, count, corners and the box of their
 /// ends (quarter pixels).
 #[derive(Debug, Clone, Copy)]
@@ -410,10 +421,7 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
             if m & (1 << k) != 0 {
                 continue;
             }
-            let sides = u8::from(x <= reach_q)
-                | u8::from(y <= reach_q) << 1
-                | u8::from(x >= w_q - 4 - reach_q) << 2
-                | u8::from(y >= h_q - 4 - reach_q) << 3;
+            let sides = border_sides(x, y, reach_q, (w_q, h_q));
             if let Some(g) = groups.stats_mut(usize::from(root)) {
                 if sides == 0 {
                     g.open_ends = g.open_ends.saturating_add(1);
@@ -466,13 +474,12 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
     // The groups the box takes (by root label).
     let mut taken = [false; MAX_SEGMENTS];
     for (l, g) in roots() {
-        if l == best_root || (best.reaches(&g, reach_q) && (g.corners > 0 || square(l))) {
-            if l != best_root {
-                b.merge(&g);
-            }
-            if let Some(t) = taken.get_mut(l) {
-                *t = true;
-            }
+        let part = l != best_root && best.reaches(&g, reach_q) && (g.corners > 0 || square(l));
+        if part {
+            b.merge(&g);
+        }
+        if let Some(t) = taken.get_mut(l) {
+            *t = part || l == best_root;
         }
     }
     // Pixels whose centres lie inside the ends' box (an edge lies between two pixels):
@@ -487,11 +494,11 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
         hi(b.x1_q, width).max(x0) + 1,
         hi(b.y1_q, height).max(y0) + 1,
     );
-    // An edge that runs into the frame's border (more across it than along) and ends
-    // at it goes on beyond: the 2×2 blocks end half a pixel inside, so its segment
-    // stops there and the box one pixel short of the border.
-    let (w_q, h_q) = (width as i32 * 4, height as i32 * 4);
-    let at = BORDER_END_Q;
+    // The sides the box is carried to: those an edge runs into (more across the border
+    // than along it) and ends at — the 2×2 blocks end half a pixel inside, so its
+    // segment stops there and the box one pixel short of the border — and, for an
+    // outline closed by the border, those its free ends reach.
+    let mut carried = 0u8;
     for (i, s) in segments.iter().enumerate() {
         if !taken
             .get(usize::from(groups.find(i as u8)))
@@ -500,38 +507,32 @@ pub fn strongest(segments: &[Segment], width: usize, height: usize) -> Option<Ou
         {
             continue;
         }
-        let across_x = i32::from(s.dir_x).abs() < i32::from(s.dir_y).abs();
+        // Left and right for an edge across the vertical sides, else top and bottom.
+        let across = if i32::from(s.dir_x).abs() < i32::from(s.dir_y).abs() {
+            0b0101
+        } else {
+            0b1010
+        };
         for (x, y) in ends(s) {
-            if across_x && x <= at {
-                x0 = 0;
-            }
-            if across_x && x >= w_q - 2 - at {
-                x1 = last(width) as u16 + 1;
-            }
-            if !across_x && y <= at {
-                y0 = 0;
-            }
-            if !across_x && y >= h_q - 2 - at {
-                y1 = last(height) as u16 + 1;
-            }
+            carried |= border_sides(x, y, BORDER_END_Q, (w_q, h_q)) & across;
         }
     }
     let closed = closed_by_border(&best);
     if closed {
-        // The piece runs on to the border its free ends reach.
-        let side = |bit: u8| best.border_sides & (1 << bit) != 0;
-        if side(0) {
-            x0 = 0;
-        }
-        if side(1) {
-            y0 = 0;
-        }
-        if side(2) {
-            x1 = last(width) as u16 + 1;
-        }
-        if side(3) {
-            y1 = last(height) as u16 + 1;
-        }
+        carried |= best.border_sides;
+    }
+    let side = |bit: u8| carried & (1 << bit) != 0;
+    if side(0) {
+        x0 = 0;
+    }
+    if side(1) {
+        y0 = 0;
+    }
+    if side(2) {
+        x1 = last(width) as u16 + 1;
+    }
+    if side(3) {
+        y1 = last(height) as u16 + 1;
     }
     Some(Outline {
         roi: Roi { x0, y0, x1, y1 },
@@ -742,6 +743,12 @@ mod tests {
         let top = seg(2.0, 24.5, 60.0, 24.5, 0.0, -1.0);
         let o = strongest(&[left, top, right], 120, 90).unwrap();
         assert_eq!(o.roi.x0, 1, "{o:?}");
+        // The same at the right border, an end 1 px from the last pixel centre (119).
+        let top = seg(60.0, 24.5, 118.0, 24.5, 0.0, -1.0);
+        let left = seg(58.5, 26.0, 58.5, 63.0, -1.0, 0.0);
+        let o = strongest(&[left, top], 120, 90).unwrap();
+        assert!(!o.closed_by_border, "{o:?}");
+        assert_eq!(o.roi.x1, 120, "{o:?}");
     }
 
     #[test]

@@ -199,9 +199,9 @@ fn far_ring_level(frame: &Frame<'_>, hull: Roi) -> Option<(u64, u64)> {
     sum.checked_div(n).map(|level| (level, n))
 }
 
-/// A blob has a halo when the pixels beside it (not at the top DN, 4-adjacent to one
-/// that is) depart from the surroundings' level by at least this share (1/4) of the
-/// way to the top DN. A target far above the top DN saturates every pixel its light
+/// A blob has a halo when the pixels just outside its outline (see [`has_halo`])
+/// depart from the surroundings' level by at least this share (1/4) of the way to the
+/// top DN. A target far above the top DN saturates every pixel its light
 /// reaches through the kernel, so the pixels beside its blob hold no light (famA's
 /// and famB's saturated targets: a median share of 0.00, 90th percentile 0.03); one
 /// barely above it shows its blurred edge there, bright but unsaturated (famAT's
@@ -213,8 +213,8 @@ fn far_ring_level(frame: &Frame<'_>, hull: Roi) -> Option<(u64, u64)> {
 /// +0.0004, famAT +0.0155, no false alarm added; held out famBT +0.0117, famBW +0.0032,
 /// famB +0.0013. (Read from every pixel beside a saturated one, holes included, famA
 /// +0.0007, but the pass over the blob's whole box cost the flight demo's detection
-/// frame, a large saturated plate, 0.2 M instructions.) Without the "cut leaves a box" condition famA and famAF
-/// gain +0.0036 more, but the Moon's disc (a few pixels just above the top DN, which
+/// frame, a large saturated plate, 0.2 M instructions.) Without the "cut leaves a box"
+/// condition famA and famAF gain +0.0036 more, but the Moon's disc (a few pixels just above the top DN, which
 /// the cut reduced to a pixel and dropped) is boxed on two of family A's frames without
 /// a target (`famA/000084`, `famAT/000138`): the Moon is then a false alarm as any
 /// saturated blob is, a limit left to a rule that knows it (its direction).
@@ -410,9 +410,9 @@ pub enum Saturated {
 /// is narrower on a side than 2 · `erode_px` + 1 px, or has a bright halo
 /// ([`HALO_SHARE_DIV`]) and its cut would leave a box, else [`Saturated::Cut`] (one
 /// pixel more off a side that is a corner's tip, [`TIP_MAX_PX`]); otherwise
-/// [`Saturated::Neither`]. Cost: besides the hull and rings, one pass over the hull
-/// grown by a pixel (the halo), and at most four lines of the cut box, 5 reads a pixel
-/// (the tips).
+/// [`Saturated::Neither`]. Cost: besides the hull and rings, a scan in from each side
+/// of the hull to the blob (the halo), and at most four lines of the cut box, 5 reads
+/// a pixel (the tips).
 pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated {
     let Some(hull) = blob_hull(frame, roi) else {
         return Saturated::Neither;
@@ -436,10 +436,9 @@ pub fn saturated_target(frame: &Frame<'_>, roi: Roi, erode_px: u16) -> Saturated
             .clip(fw, fh),
         );
     }
-    let (mut x0, mut x1) = cut_span(hull.x0, hull.x1, erode_px, fw);
-    let (mut y0, mut y1) = cut_span(hull.y0, hull.y1, erode_px, fh);
+    let ((mut x0, mut x1), (mut y0, mut y1)) = (cut_x, cut_y);
     // A side whose outermost covered line is a corner's tip: one pixel more (keeping
-    // at least 1 px, and every side on the frame's edge).
+    // at least MIN_BOX_SIDE_PX + 1 px, and every side on the frame's edge).
     if erode_px > 0 {
         let tip = |fixed: u16, span: (u16, u16), vertical: bool| {
             u32::from(span.1 - span.0) >= 2 * TIP_MAX_PX
