@@ -281,11 +281,12 @@ fn main() {
                 }
                 // The stage whose box this is (what the score's scale is): the work's
                 // telemetry is set only by the stage that answered (`deep_space()`:
-                // stage 2c, or 2d when on).
+                // stage 2c, 2d or 2e; `outline()`: stage 5f).
                 let work = scratch.work();
                 let stage = match d.roi {
                     None => "none",
                     Some(r) if work.spot().is_some_and(|(b, _)| b == r) => "spot",
+                    Some(_) if work.outline().is_some() => "outline",
                     Some(_) if work.blob_won() => "blob",
                     Some(_) if work.deep_space().is_some() => "deep-space",
                     Some(_) => "classifier",

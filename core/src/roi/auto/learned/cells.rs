@@ -302,21 +302,30 @@ fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16,
     if any > max_dn {
         return block_clamped(rows, max_dn);
     }
-    let mut acc = 0u32;
-    let mut best = 0u16;
-    let mut n_sat = 0u8;
+    // Per column of the cell (a lane each), down its 8 rows: the sums, the largest
+    // step and the saturated count, folded over the columns at the end. Eight
+    // independent lanes of `u16`/`u32` arithmetic, which the compiler turns into
+    // vector instructions: x86-64 (callgrind, 40 frames of family A) `fill_cells` 28 →
+    // 10 instructions per pixel against one running maximum over all 64 pixels. The
+    // same sums, step and count.
+    let mut sums = [0u32; CELL_PX];
+    let mut steps = [0u16; CELL_PX];
+    let mut sats = [0u8; CELL_PX];
     for k in 1..=CELL_PX {
         // Unrolled: every index is a constant in range (no panic path).
         let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
-        for i in 1..=CELL_PX {
-            let v = mid[i];
-            n_sat += u8::from(v >= max_dn);
-            acc += u32::from(v);
-            best = best
-                .max(mid[i - 1].abs_diff(mid[i + 1]))
-                .max(up[i].abs_diff(down[i]));
+        for i in 0..CELL_PX {
+            let v = mid[i + 1];
+            sats[i] += u8::from(v >= max_dn);
+            sums[i] += u32::from(v);
+            steps[i] = steps[i]
+                .max(mid[i].abs_diff(mid[i + 2]))
+                .max(up[i + 1].abs_diff(down[i + 1]));
         }
     }
+    let acc = sums.iter().sum();
+    let best = steps.iter().copied().max().unwrap_or(0);
+    let n_sat = sats.iter().sum();
     (acc, best, n_sat)
 }
 
