@@ -43,17 +43,30 @@ fn library_detection(method: Method, path: &Path) -> Detection {
         .expect("default parameters are valid")
 }
 
+/// `auto-v2`'s stage names (`learned::Stage::name`), the values of a line's `"stage"`.
+const STAGES: [&str; 6] = [
+    "tracked",
+    "blob",
+    "deep-space",
+    "classifier",
+    "spot",
+    "outline",
+];
+
 /// Parses one `detect --json` line and checks its shape; returns (file, method, bbox).
+/// An `auto-v2` line with a box carries a `"stage"` too (checked by [`stage_of_line`]).
 fn parse_line(line: &str) -> (String, String, Option<[u16; 4]>) {
     let v: Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
     let obj = v.as_object().expect("a JSON object per line");
     let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
     keys.sort_unstable();
-    assert_eq!(
-        keys,
-        ["bbox", "file", "method", "score", "time_us"],
-        "{line}"
-    );
+    let staged = obj["method"] == "auto-v2" && !obj["bbox"].is_null();
+    let want: &[&str] = if staged {
+        &["bbox", "file", "method", "score", "stage", "time_us"]
+    } else {
+        &["bbox", "file", "method", "score", "time_us"]
+    };
+    assert_eq!(keys, want, "{line}");
     let time = obj["time_us"].as_f64().expect("time_us is a number");
     assert!(time.is_finite() && time >= 0.0, "{line}");
     let score = obj["score"].as_f64().expect("score is a number");
@@ -87,6 +100,30 @@ fn parse_line(line: &str) -> (String, String, Option<[u16; 4]>) {
             .to_owned(),
         bbox,
     )
+}
+
+/// The `"stage"` of a `detect --json` line (`None` without one), one of [`STAGES`].
+fn stage_of_line(line: &str) -> Option<String> {
+    let v: Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
+    let stage = v
+        .get("stage")?
+        .as_str()
+        .expect("stage is a string")
+        .to_owned();
+    assert!(STAGES.contains(&stage.as_str()), "{line}");
+    Some(stage)
+}
+
+/// The stage of `auto-v2`'s box on `path` by the library (its default parameters, the
+/// telemetry of its scratch).
+fn library_stage(path: &Path) -> Option<&'static str> {
+    let buf = read_frame(path, None).expect("readable frame");
+    let frame = buf.view().expect("valid frame");
+    let mut bank = Box::new(Detectors::new());
+    let d = bank
+        .detect(&Method::AutoV2.default_params(), &frame)
+        .expect("default parameters are valid");
+    bank.auto_v2().work().stage(d.roi).map(|s| s.name())
 }
 
 #[test]
@@ -145,6 +182,7 @@ fn detect_json_all_methods_and_files() {
     let lines = stdout_lines(&out);
     let n = Method::ALL.len();
     assert_eq!(lines.len(), n * files.len(), "{lines:?}");
+    let mut staged = 0;
     for (i, line) in lines.iter().enumerate() {
         let (f, m, bbox) = parse_line(line);
         let file = &files[i / n];
@@ -153,7 +191,14 @@ fn detect_json_all_methods_and_files() {
         assert_eq!(m, method.name());
         let want = library_detection(method, file);
         assert_eq!(bbox, want.roi.map(|r| r.to_array()), "{line}");
+        // `auto-v2` names the stage that gave its box, as the library's telemetry.
+        let want_stage = (method == Method::AutoV2)
+            .then(|| library_stage(file))
+            .flatten();
+        assert_eq!(stage_of_line(line).as_deref(), want_stage, "{line}");
+        staged += usize::from(want_stage.is_some());
     }
+    assert!(staged > 0, "an auto-v2 box with its stage");
     // The default method is all of them.
     let out = run(&["detect", "--json", files[0].to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr_text(&out));

@@ -877,6 +877,34 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
                 .iter()
                 .all(|r| r[g] != "prior" || r[m].starts_with("auto"))
         );
+        // `auto-v2`'s boxes name the stage that gave them (a column and a group);
+        // no other method's do.
+        let sc = col(&h, "stage");
+        let mut staged = 0;
+        for r in &rows {
+            let boxed = !r[x0].is_empty();
+            if r[mc] == "auto-v2" && boxed {
+                let known = [
+                    "tracked",
+                    "blob",
+                    "deep-space",
+                    "classifier",
+                    "spot",
+                    "outline",
+                ];
+                assert!(known.contains(&r[sc].as_str()), "{r:?}");
+                staged += 1;
+            } else {
+                assert_eq!(r[sc], "", "{r:?}");
+            }
+        }
+        let grouped: usize = summary
+            .iter()
+            .filter(|r| r[g] == "stage")
+            .inspect(|r| assert_eq!(r[m], "auto-v2", "{r:?}"))
+            .map(|r| r[n].parse::<usize>().unwrap())
+            .sum();
+        assert_eq!((staged, grouped), (2, 2));
     }
 }
 

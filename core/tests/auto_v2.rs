@@ -32,8 +32,8 @@ use tirroi_core::roi::auto::learned::body::BodyParams;
 use tirroi_core::roi::auto::learned::look::Look;
 use tirroi_core::roi::auto::learned::{
     AutoV2, AutoV2Scratch, AutoV2Work, BORDER_PIECE_SCORE_PERMILLE, BlobRule,
-    DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE, TRACKED_SCORE_PERMILLE, frame_segments,
-    polygon, rated_spots,
+    DEEP_SPACE_SCORE_PERMILLE, SMALL_TARGET_SCORE_PERMILLE, Stage, TRACKED_SCORE_PERMILLE,
+    frame_segments, polygon, rated_spots,
     segments::{self, Segment},
 };
 use tirroi_core::roi::track::Tracker;
@@ -258,12 +258,12 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
             // The confidence is the winner's (what telemetry reads): the saturated
             // blob's when it won, else the classifier's.
             let work = scratch.work();
-            let score = if work.tracked() {
+            let (score, stage) = if work.tracked() {
                 // The fast tracking path's box: only with a prior and a look, and no
                 // other stage ran.
                 prop_assert!(det.prior.is_some() && det.look.is_some(), "{d:?}");
                 prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
-                TRACKED_SCORE_PERMILLE
+                (TRACKED_SCORE_PERMILLE, Stage::Tracked)
             } else if let Some(o) = work.outline() {
                 // Stage 5f's box: the other stages' answer was none or rated lower, on
                 // a whole-frame search; no other stage's telemetry.
@@ -271,20 +271,23 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                 prop_assert_eq!(Some(o.roi), d.roi);
                 prop_assert!(work.winner().is_none() && work.spot().is_none(), "{d:?}");
                 prop_assert!(!work.blob_won() && work.deep_space().is_none(), "{d:?}");
-                o.score_permille()
+                (o.score_permille(), Stage::Outline)
             } else if let Some((roi, score)) = work.spot() {
                 // Stage 5e's box: the other stages answered no target, or their box was
                 // rated below `spot_competes_below_permille` and lower than the spot.
                 prop_assert!(det.spot, "{d:?}");
                 prop_assert_eq!(Some(roi), d.roi);
-                score
+                (score, Stage::Spot)
             } else if work.blob_won() {
                 prop_assert!(det.blob != BlobRule::Off, "{d:?}");
-                work.blob().expect("a blob won").score_permille()
+                (
+                    work.blob().expect("a blob won").score_permille(),
+                    Stage::Blob,
+                )
             } else if work.deep_space().is_some() {
                 // Stage 2c's or 2d's box (deep space): its constant confidence, no blob.
                 prop_assert!(det.deep_space && work.blob().is_none(), "{d:?}");
-                if d.score_permille == SMALL_TARGET_SCORE_PERMILLE {
+                let score = if d.score_permille == SMALL_TARGET_SCORE_PERMILLE {
                     prop_assert!(det.small_target, "{d:?}");
                     SMALL_TARGET_SCORE_PERMILLE
                 } else if d.score_permille == BORDER_PIECE_SCORE_PERMILLE {
@@ -292,11 +295,17 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
                     BORDER_PIECE_SCORE_PERMILLE
                 } else {
                     DEEP_SPACE_SCORE_PERMILLE
-                }
+                };
+                (score, Stage::DeepSpace)
             } else {
-                work.winner().expect("a box has a winner").score_permille()
+                (
+                    work.winner().expect("a box has a winner").score_permille(),
+                    Stage::Classifier,
+                )
             };
             prop_assert_eq!(score, d.score_permille);
+            // The stage the telemetry names is the branch's.
+            prop_assert_eq!(work.stage(d.roi), Some(stage), "{:?}", d);
             // The threshold at the confidence keeps the same box; one ‰ above, `null`.
             let at = AutoV2 {
                 min_score_permille: d.score_permille,
@@ -316,6 +325,7 @@ fn check(img: &Img, det: AutoV2) -> Result<(), TestCaseError> {
         }
         None => {
             prop_assert_eq!(d.score_permille, 0, "{:?}", d);
+            prop_assert_eq!(scratch.work().stage(d.roi), None);
             // Below the threshold: the winner's confidence, when there was one.
             if let Some(w) = scratch.work().winner() {
                 prop_assert!(w.score_permille() < det.min_score_permille, "{w:?}");
@@ -840,11 +850,21 @@ fn an_outline_replaces_a_weaker_answer_and_only_that() {
                     "seed {seed}"
                 );
                 assert_eq!(scratch.work().outline(), Some(o), "seed {seed}");
+                assert_eq!(
+                    scratch.work().stage(after.roi),
+                    Some(Stage::Outline),
+                    "seed {seed}"
+                );
                 replaced += 1;
             }
             _ => {
                 assert_eq!(after, before, "seed {seed}");
                 assert_eq!(scratch.work().outline(), None, "seed {seed}");
+                assert_ne!(
+                    scratch.work().stage(after.roi),
+                    Some(Stage::Outline),
+                    "seed {seed}"
+                );
                 kept += 1;
             }
         }

@@ -82,7 +82,8 @@ pub struct DetectArgs {
 /// The JSON line of `tirroi detect --json`: `{"file","method","bbox":[x0,y0,x1,y1] or
 /// null,"score","time_us"}`, `score` the detector's confidence in 0–1 (0 for `null`;
 /// see `Detection::score_permille`), `time_us` the median over `--repeat` runs of the core call alone
-/// (the conventions in `docs/architecture.md`).
+/// (the conventions in `docs/architecture.md`); on `auto-v2` lines with a box also
+/// `"stage"`, the stage that gave it (`learned::Stage::name`).
 #[derive(Debug, Serialize)]
 struct DetectLine<'a> {
     file: &'a str,
@@ -90,6 +91,9 @@ struct DetectLine<'a> {
     bbox: Option<[u16; 4]>,
     score: f32,
     time_us: f64,
+    /// `auto-v2` lines with a box: the stage that gave it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stage: Option<&'static str>,
     /// With `--budget`, on `auto` lines only.
     #[serde(skip_serializing_if = "Option::is_none")]
     budget: Option<BudgetLine>,
@@ -201,6 +205,10 @@ pub fn run(args: &DetectArgs) -> ExitCode {
             if args.track {
                 *prior = d.roi;
             }
+            let stage = (method == Method::AutoV2)
+                .then(|| bank.auto_v2_stage(&view, d.roi))
+                .flatten()
+                .map(|s| s.name());
             let file = path.to_string_lossy();
             let written = if json {
                 let line = DetectLine {
@@ -209,6 +217,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     bbox: d.roi.map(|r| r.to_array()),
                     score: d.score(),
                     time_us: (time_us * 1000.0).round() / 1000.0,
+                    stage,
                     budget: spent,
                 };
                 serde_json::to_string(&line)
@@ -219,6 +228,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     .roi
                     .map(|r| format!("{:?}", r.to_array()))
                     .unwrap_or_else(|| "none".into());
+                let stage = stage.map(|s| format!("  stage {s}")).unwrap_or_default();
                 let spent = spent
                     .map(|b| {
                         format!(
@@ -231,7 +241,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
                     .unwrap_or_default();
                 writeln!(
                     out,
-                    "{file}  {:<8}  bbox {bbox:<22}  score {:.3}  {time_us:>9.1} us  threshold {}  foreground {} px{spent}",
+                    "{file}  {:<8}  bbox {bbox:<22}  score {:.3}  {time_us:>9.1} us  threshold {}  foreground {} px{stage}{spent}",
                     method.name(),
                     d.score(),
                     d.threshold,

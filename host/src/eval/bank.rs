@@ -4,8 +4,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use tirroi_core::capacity::{Cap640x512, Cap1024x768};
-use tirroi_core::roi::auto::learned::AutoV2;
 use tirroi_core::roi::auto::learned::look::Look;
+use tirroi_core::roi::auto::learned::{AutoV2, Stage};
 use tirroi_core::roi::auto::{Auto, AutoScratch, BudgetReport, WorkBudget};
 use tirroi_core::roi::track::Tracker;
 use tirroi_core::roi::{Detectors, Params};
@@ -217,6 +217,27 @@ impl DetectorBank {
             *tracker = t;
         }
         Ok(timed)
+    }
+
+    /// The stage of `auto-v2` that gave `answer`, its last call's box on `frame`
+    /// (`AutoV2Work::stage`, read from the scratch of the capacity that ran `frame`);
+    /// `None` for no box, or when that capacity's scratch was never used.
+    pub fn auto_v2_stage(&mut self, frame: &Frame<'_>, answer: Option<Roi>) -> Option<Stage> {
+        if fits::<tirroi_core::Reference>(frame) {
+            self.scratch.auto_v2().work().stage(answer)
+        } else if fits::<Cap640x512>(frame) {
+            self.scratch_640x512
+                .as_mut()?
+                .auto_v2()
+                .work()
+                .stage(answer)
+        } else {
+            self.scratch_1024x768
+                .as_mut()?
+                .auto_v2()
+                .work()
+                .stage(answer)
+        }
     }
 
     /// Runs `method` `repeat` times (at least once) and returns the detection with the

@@ -429,6 +429,8 @@ pub fn score_predictions(
                 truth: row.roi.to_array(),
                 iou: bbox.map_or(0.0, |r| r.iou(&row.roi)),
                 time_us: p.map_or(0.0, |p| p.time_us),
+                // A predictions file names no stage.
+                stage: None,
                 groups: row.groups.clone(),
                 range_m: row.range_m,
             }

@@ -467,6 +467,10 @@ pub struct FrameScore {
     pub iou: f32,
     /// Median core time over the repeats, µs.
     pub time_us: f64,
+    /// The stage of `auto-v2` that gave the box (`tracked`, `blob`, `deep-space`,
+    /// `classifier`, `spot`, `outline`: `learned::Stage::name`); `None` for the other
+    /// methods and without a box. Also the frame's [`STAGE_GROUP`] group.
+    pub stage: Option<&'static str>,
     /// Group labels.
     pub groups: Vec<(String, String)>,
     /// Camera–target distance, m, when known.
@@ -667,12 +671,36 @@ fn score_one(
     path: &Path,
     repeat: usize,
 ) -> Result<(FrameScore, Option<Roi>), EvalError> {
-    frame_score(bank.detect_timed(method, view, repeat), method, row, path)
+    let timed = bank.detect_timed(method, view, repeat);
+    let stage = stage_of(bank, method, view, &timed);
+    frame_score(timed, stage, method, row, path)
 }
 
-/// A timed detection of `method` scored against the row's truth, and its box.
+/// The `auto-v2` stage that gave `timed`'s box ([`DetectorBank::auto_v2_stage`]), as
+/// its name; `None` for the other methods, an error or no box.
+fn stage_of(
+    bank: &mut DetectorBank,
+    method: Method,
+    view: &tirroi_core::Frame<'_>,
+    timed: &Result<(Detection, f64), DetectError>,
+) -> Option<&'static str> {
+    let (d, _) = timed.as_ref().ok()?;
+    (method == Method::AutoV2)
+        .then(|| bank.auto_v2_stage(view, d.roi))
+        .flatten()
+        .map(|s| s.name())
+}
+
+/// The group each `auto-v2` frame with a box gets, valued by the stage that gave it
+/// ([`FrameScore::stage`]): `summary.csv` and the Markdown table then show each
+/// stage's boxes, mean IoU, hit rate and calibration gap.
+pub const STAGE_GROUP: &str = "stage";
+
+/// A timed detection of `method` scored against the row's truth, and its box; `stage`
+/// the `auto-v2` stage that gave it ([`stage_of`]).
 fn frame_score(
     timed: Result<(Detection, f64), DetectError>,
+    stage: Option<&'static str>,
     method: Method,
     row: &TruthRow,
     path: &Path,
@@ -687,7 +715,13 @@ fn frame_score(
         truth: row.roi.to_array(),
         iou: d.roi.map_or(0.0, |r| r.iou(&row.roi)),
         time_us,
-        groups: row.groups.clone(),
+        stage,
+        groups: row
+            .groups
+            .iter()
+            .cloned()
+            .chain(stage.map(|s| (STAGE_GROUP.to_string(), s.to_string())))
+            .collect(),
         range_m: row.range_m,
     };
     Ok((score, d.roi))
@@ -739,7 +773,8 @@ fn score_sequence(
             });
             let (mut score, roi) = if m == Method::AutoV2 {
                 let timed = bank.track_timed(&mut tracker, &view, options.repeat);
-                frame_score(timed, m, row, &path)?
+                let stage = stage_of(&mut bank, m, &view, &timed);
+                frame_score(timed, stage, m, row, &path)?
             } else {
                 bank.set_prior_of(m, previous);
                 score_one(&mut bank, m, &view, row, &path, options.repeat)?
@@ -937,7 +972,7 @@ pub fn write_reports(
     let io = |p: &Path, e: std::io::Error| EvalError(format!("{}: cannot write: {e}", p.display()));
     std::fs::create_dir_all(out).map_err(|e| io(out, e))?;
     let mut csv = String::from(
-        "file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us,score\n",
+        "file,method,x0,y0,x1,y1,truth_x0,truth_y0,truth_x1,truth_y1,iou,time_us,score,stage\n",
     );
     // No target: empty truth fields, as in `truth.csv`.
     for s in scores {
@@ -951,8 +986,13 @@ pub fn write_reports(
             ",,,".to_string()
         };
         csv.push_str(&format!(
-            "{},{},{b},{t},{:.4},{:.2},{:.3}\n",
-            s.file, s.method, s.iou, s.time_us, s.score
+            "{},{},{b},{t},{:.4},{:.2},{:.3},{}\n",
+            s.file,
+            s.method,
+            s.iou,
+            s.time_us,
+            s.score,
+            s.stage.unwrap_or("")
         ));
     }
     let p = out.join("scores.csv");
@@ -1000,6 +1040,7 @@ mod tests {
             truth: [0, 0, 1, 1],
             iou,
             time_us,
+            stage: None,
             groups: groups
                 .iter()
                 .map(|(k, v)| (k.to_string(), v.to_string()))

@@ -859,6 +859,27 @@ impl<C: FrameCapacity> AutoV2Work<C> {
         self.outline
     }
 
+    /// The stage whose box `answer` is (the last frame's answer, as the call returned
+    /// it): read from the telemetry above, which only the answering stage sets;
+    /// `None` for no box. A flight computer logs it beside the box (why this box);
+    /// `tirroi eval` groups its statistics by it.
+    pub fn stage(&self, answer: Option<Roi>) -> Option<Stage> {
+        let r = answer?;
+        Some(if self.tracked {
+            Stage::Tracked
+        } else if self.outline.is_some() {
+            Stage::Outline
+        } else if self.spot.is_some_and(|(b, _)| b == r) {
+            Stage::Spot
+        } else if self.blob_won {
+            Stage::Blob
+        } else if self.deep_space.is_some() {
+            Stage::DeepSpace
+        } else {
+            Stage::Classifier
+        })
+    }
+
     /// The last frame's candidate below the gate ([`AutoV2::candidate_floor_permille`]):
     /// the region stage's winner refined, or else stage 5e's most confident spot,
     /// with its confidence ‰, when that lies in `[floor, gate)`; `None` when the call
@@ -895,6 +916,49 @@ impl<C: FrameCapacity> ConstInit for AutoV2Work<C> {
         outline: None,
         candidate: None,
     };
+}
+
+/// The stage of `auto-v2` that gave a frame's box ([`AutoV2Work::stage`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Stage {
+    /// The fast tracking path ([`AutoV2::look`]): the last box's look found again.
+    Tracked,
+    /// Stage 2b: the frame's largest saturated blob ([`blob`], stage 8's cut).
+    Blob,
+    /// Stages 2c–2e: cells departing from a fitted sky ([`smooth`]: deep space, a
+    /// small target there, or the sky beside the Earth).
+    DeepSpace,
+    /// Stages 3–8: the cell classifier's winner, refined.
+    Classifier,
+    /// Stage 5e: a small target among clutter ([`spot`]).
+    Spot,
+    /// Stage 5f: the frame's straight outline ([`polygon`]).
+    Outline,
+}
+
+impl Stage {
+    /// Every stage, in the order above.
+    pub const ALL: [Stage; 6] = [
+        Stage::Tracked,
+        Stage::Blob,
+        Stage::DeepSpace,
+        Stage::Classifier,
+        Stage::Spot,
+        Stage::Outline,
+    ];
+
+    /// The stage's name in reports: `tracked`, `blob`, `deep-space`, `classifier`,
+    /// `spot`, `outline`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Stage::Tracked => "tracked",
+            Stage::Blob => "blob",
+            Stage::DeepSpace => "deep-space",
+            Stage::Classifier => "classifier",
+            Stage::Spot => "spot",
+            Stage::Outline => "outline",
+        }
+    }
 }
 
 /// `auto-v2`'s scratch memory at capacity `C`.
@@ -3087,13 +3151,20 @@ mod tests {
             .detect(&frame, &mut scratch)
             .unwrap();
         assert!(scratch.work().tracked(), "{fast:?}");
+        assert_eq!(scratch.work().stage(fast.roi), Some(Stage::Tracked));
         assert_eq!(fast.score_permille, TRACKED_SCORE_PERMILLE);
         assert!(scratch.work().winner().is_none());
         let r = fast.roi.expect("the tracked block");
         assert!(r.iou(&truth) > 0.9, "{r:?}");
-        // The next call without a look: the flag goes.
-        det.detect(&frame, &mut scratch).unwrap();
+        // The next call without a look: the flag goes (the window's search answers:
+        // the classifier's winner around the prior).
+        let searched = det.detect(&frame, &mut scratch).unwrap();
         assert!(!scratch.work().tracked());
+        assert_eq!(
+            scratch.work().stage(searched.roi),
+            Some(Stage::Classifier),
+            "{searched:?}"
+        );
         // `det` with `look` on `frame`: the search decides (the answer without it).
         let mut search_decides = |det: AutoV2, look: look::Look, frame: &Frame<'_>| {
             let want = det.detect(frame, &mut scratch).unwrap();
@@ -3155,6 +3226,7 @@ mod tests {
             .expect("deep space, boxed by stage 2c");
         assert!(seen.outliers >= 30, "{seen:?}");
         assert_eq!(d.score_permille, DEEP_SPACE_SCORE_PERMILLE);
+        assert_eq!(scratch.work().stage(d.roi), Some(Stage::DeepSpace));
         let r = d.roi.expect("the target's box");
         assert!(r.iou(&Roi::new(120, 90, 180, 140)) > 0.9, "{r:?}");
         assert_eq!(
@@ -3934,6 +4006,10 @@ mod tests {
                 );
                 assert_eq!((blob.solid_permille, blob.sides), (1000, 0), "{blob:?}");
                 assert!(scratch.work().blob_won());
+                if always.roi.is_some() {
+                    assert_eq!(scratch.work().stage(always.roi), Some(Stage::Blob));
+                }
+                assert_eq!(scratch.work().stage(None), None, "no box, no stage");
                 assert_eq!(always.score_permille, blob.score_permille());
                 if always.roi.is_some() && blob.saturated_px == block_px {
                     let block = Roi::new(200, 120, 200 + bw as u16, 120 + bh as u16);
