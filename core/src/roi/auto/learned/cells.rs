@@ -302,12 +302,48 @@ fn block_of(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16,
     if any > max_dn {
         return block_clamped(rows, max_dn);
     }
-    // Per column of the cell (a lane each), down its 8 rows: the sums, the largest
-    // step and the saturated count, folded over the columns at the end. Eight
-    // independent lanes of `u16`/`u32` arithmetic, which the compiler turns into
-    // vector instructions: x86-64 (callgrind, 40 frames of family A) `fill_cells` 28 →
-    // 10 instructions per pixel against one running maximum over all 64 pixels. The
-    // same sums, step and count.
+    if VECTOR_HOST {
+        block_columns(rows, max_dn)
+    } else {
+        block_scalar(rows, max_dn)
+    }
+}
+
+/// [`block_of`]'s sums without the clamps, pixel by pixel with one running maximum
+/// (the targets without 16-bit vector lanes: see [`VECTOR_HOST`]).
+#[inline(always)]
+fn block_scalar(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
+    let mut acc = 0u32;
+    let mut best = 0u16;
+    let mut n_sat = 0u8;
+    for k in 1..=CELL_PX {
+        // Unrolled: every index is a constant in range (no panic path).
+        let (up, mid, down) = (rows[k - 1], rows[k], rows[k + 1]);
+        for i in 1..=CELL_PX {
+            let v = mid[i];
+            n_sat += u8::from(v >= max_dn);
+            acc += u32::from(v);
+            best = best
+                .max(mid[i - 1].abs_diff(mid[i + 1]))
+                .max(up[i].abs_diff(down[i]));
+        }
+    }
+    (acc, best, n_sat)
+}
+
+/// Whether [`block_of`] runs as [`block_columns`]: on hosts whose vector units take
+/// 16-bit lanes (x86-64 with SSE4.1, AArch64). Targets without them keep the running
+/// maximum over all 64 pixels (`thumbv7m-none-eabi`: `auto-v2` 100 → 108 instructions
+/// per pixel in the column form, `scripts/flight.sh`).
+const VECTOR_HOST: bool = cfg!(any(target_arch = "x86_64", target_arch = "aarch64"));
+
+/// [`block_of`]'s sums without the clamps, per column of the cell (a lane each) down
+/// its 8 rows — the sums, the largest step and the saturated count — folded over the
+/// columns at the end: eight independent lanes of `u16`/`u32` arithmetic, which the
+/// compiler turns into vector instructions (x86-64, callgrind on 40 frames of family A:
+/// `fill_cells` 28 → 10 instructions per pixel). The same sums, step and count.
+#[inline(always)]
+fn block_columns(rows: [&[u16; CELL_PX + 2]; CELL_PX + 2], max_dn: u16) -> (u32, u16, u8) {
     let mut sums = [0u32; CELL_PX];
     let mut steps = [0u16; CELL_PX];
     let mut sats = [0u8; CELL_PX];
@@ -685,6 +721,9 @@ mod tests {
                 "block {k}"
             );
             assert_eq!(block_of(rows, top), (sum, best, n_sat), "block {k}");
+            // Both forms of the unclamped sums, whichever this build runs.
+            assert_eq!(block_columns(rows, top), (sum, best, n_sat), "block {k}");
+            assert_eq!(block_scalar(rows, top), (sum, best, n_sat), "block {k}");
             // One pixel above the top DN (never in a camera's frame): the pair form
             // declines when it is read (the clamped rows decide), not in a corner.
             if bits < 16 {
