@@ -212,11 +212,26 @@ impl Band<'_> {
     /// 59 instructions per sampled column). The sums are exact, so the wrapping
     /// arithmetic never wraps; it spares the M7 an overflow check per column.
     fn step(&mut self, row_in: &[u16], row_out: &[u16], max_dn: u16, shift: u32) {
-        let pixels = row_in
-            .iter()
-            .step_by(RING_STRIDE_PX)
-            .zip(row_out.iter().step_by(RING_STRIDE_PX));
-        for ((dn, sq), (&a, &b)) in self.dn.iter_mut().zip(self.sq.iter_mut()).zip(pixels) {
+        // The sampled columns as the first pixel of each chunk of `RING_STRIDE_PX` (and
+        // of the last, shorter chunk of an odd row): a strided read the compiler
+        // vectorises on a host (x86-64 callgrind, 20 frames of famAF: `auto-v2` 7.99 →
+        // 6.97 M instructions; `step_by` it does not).
+        let (ins, outs) = (
+            row_in.chunks_exact(RING_STRIDE_PX),
+            row_out.chunks_exact(RING_STRIDE_PX),
+        );
+        let tail = (ins.remainder().first(), outs.remainder().first());
+        let pixels = ins.map(|c| c[0]).zip(outs.map(|c| c[0]));
+        let mut n = 0usize;
+        for ((dn, sq), (a, b)) in self.dn.iter_mut().zip(self.sq.iter_mut()).zip(pixels) {
+            let [a, b] = [a, b].map(|v| u32::from(v.min(max_dn) >> shift));
+            *dn = dn.wrapping_add(a).wrapping_sub(b);
+            *sq = sq.wrapping_add(a * a).wrapping_sub(b * b);
+            n += 1;
+        }
+        if let ((Some(&a), Some(&b)), Some(dn), Some(sq)) =
+            (tail, self.dn.get_mut(n), self.sq.get_mut(n))
+        {
             let [a, b] = [a, b].map(|v| u32::from(v.min(max_dn) >> shift));
             *dn = dn.wrapping_add(a).wrapping_sub(b);
             *sq = sq.wrapping_add(a * a).wrapping_sub(b * b);
@@ -1030,6 +1045,44 @@ mod tests {
             sd_shift: 0,
             max_dn,
             step_rank_code: 0,
+        }
+    }
+
+    /// A band's column sums after rows enter and leave ([`Band::add`], [`Band::step`])
+    /// are the sums of its rows' sampled columns, on rows of odd and even lengths (an
+    /// odd row's last pixel is a sampled column) and DN above the top.
+    #[test]
+    fn band_sums_equal_brute_force() {
+        let mut rand = super::super::xorshift32(0xBA_4D5);
+        for w in [1usize, 2, 3, 13, 14, 327, 328] {
+            let ws = w.div_ceil(RING_STRIDE_PX);
+            let (max_dn, shift) = (4095u16, 1u32);
+            let rows: Vec<Vec<u16>> = (0..9)
+                .map(|_| (0..w).map(|_| (rand() % 5000) as u16).collect())
+                .collect();
+            let (mut dn, mut sq) = (std::vec![0u32; ws], std::vec![0u32; ws]);
+            let mut band = Band {
+                dn: &mut dn,
+                sq: &mut sq,
+            };
+            for r in &rows[..4] {
+                band.add(r, max_dn, shift);
+            }
+            // Rows 4.. enter one at a time, rows 0.. leave: the band holds 4 rows.
+            for k in 4..rows.len() {
+                band.step(&rows[k], &rows[k - 4], max_dn, shift);
+            }
+            let v = |x: u16| u32::from(x.min(max_dn) >> shift);
+            for c in 0..ws {
+                let held = &rows[rows.len() - 4..];
+                let want_dn: u32 = held.iter().map(|r| v(r[c * RING_STRIDE_PX])).sum();
+                let want_sq: u32 = held.iter().map(|r| v(r[c * RING_STRIDE_PX]).pow(2)).sum();
+                assert_eq!(
+                    (band.dn[c], band.sq[c]),
+                    (want_dn, want_sq),
+                    "w {w} column {c}"
+                );
+            }
         }
     }
 
