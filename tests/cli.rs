@@ -3,12 +3,13 @@
 
 mod cli_common;
 
-use cli_common::run;
+use cli_common::{STAGE_NAMES, run};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use serde_json::Value;
 use tirroi::core::roi::Detectors;
+use tirroi::core::roi::auto::learned::Stage;
 use tirroi::core::{Detection, Method, Roi};
 use tirroi::host::imaging::fixture;
 use tirroi::host::imaging::image_io::read_frame;
@@ -42,16 +43,6 @@ fn library_detection(method: Method, path: &Path) -> Detection {
     bank.detect(&method.default_params(), &frame)
         .expect("default parameters are valid")
 }
-
-/// `auto-v2`'s stage names (`learned::Stage::name`), the values of a line's `"stage"`.
-const STAGES: [&str; 6] = [
-    "tracked",
-    "blob",
-    "deep-space",
-    "classifier",
-    "spot",
-    "outline",
-];
 
 /// Parses one `detect --json` line and checks its shape; returns (file, method, bbox).
 /// An `auto-v2` line with a box carries a `"stage"` too (checked by [`stage_of_line`]).
@@ -102,7 +93,7 @@ fn parse_line(line: &str) -> (String, String, Option<[u16; 4]>) {
     )
 }
 
-/// The `"stage"` of a `detect --json` line (`None` without one), one of [`STAGES`].
+/// The `"stage"` of a `detect --json` line (`None` without one), one of [`STAGE_NAMES`].
 fn stage_of_line(line: &str) -> Option<String> {
     let v: Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
     let stage = v
@@ -110,8 +101,15 @@ fn stage_of_line(line: &str) -> Option<String> {
         .as_str()
         .expect("stage is a string")
         .to_owned();
-    assert!(STAGES.contains(&stage.as_str()), "{line}");
+    assert!(STAGE_NAMES.contains(&stage.as_str()), "{line}");
     Some(stage)
+}
+
+/// The stage names of the interface are the library's, in its order.
+#[test]
+fn stage_names_are_the_librarys() {
+    let names = Stage::ALL.map(Stage::name);
+    assert_eq!(names, STAGE_NAMES);
 }
 
 /// The stage of `auto-v2`'s box on `path` by the library (its default parameters, the

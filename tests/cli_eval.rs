@@ -10,7 +10,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use cli_common::{run, tirroi};
+use cli_common::{STAGE_NAMES, run, tirroi};
 use tirroi::core::Method;
 use tirroi::host::imaging::fits::read_fits;
 use tirroi::host::imaging::image_io::{HAYABUSA2_TIR_CROP, ReadOptions, read_frame_with};
@@ -884,15 +884,7 @@ fn eval_track_sequence_starts_each_sequence_without_a_prior() {
         for r in &rows {
             let boxed = !r[x0].is_empty();
             if r[mc] == "auto-v2" && boxed {
-                let known = [
-                    "tracked",
-                    "blob",
-                    "deep-space",
-                    "classifier",
-                    "spot",
-                    "outline",
-                ];
-                assert!(known.contains(&r[sc].as_str()), "{r:?}");
+                assert!(STAGE_NAMES.contains(&r[sc].as_str()), "{r:?}");
                 staged += 1;
             } else {
                 assert_eq!(r[sc], "", "{r:?}");

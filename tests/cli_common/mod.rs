@@ -51,3 +51,17 @@ pub fn run(args: &[&str]) -> Output {
         .output()
         .expect("run tirroi")
 }
+
+/// The values `auto-v2`'s stage takes in `tirroi detect --json` (`"stage"`) and in
+/// `eval`'s `scores.csv` (`stage`): the interface, written out here and checked against
+/// `learned::Stage::name` in `tests/cli.rs`. (Not every test crate that includes this
+/// module uses it.)
+#[allow(dead_code)]
+pub const STAGE_NAMES: [&str; 6] = [
+    "tracked",
+    "blob",
+    "deep-space",
+    "classifier",
+    "spot",
+    "outline",
+];
