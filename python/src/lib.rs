@@ -194,15 +194,22 @@ fn frame_pixels(dn: &PyReadonlyArrayDyn<'_, u16>, bits: u8) -> PyResult<(Vec<u16
 }
 
 /// A detection as the Python half takes it: (box [x0, y0, x1, y1) or None, score 0–1,
-/// threshold, foreground px).
-type DetectionTuple = (Option<[u16; 4]>, f32, u32, u32);
+/// threshold, foreground px, `auto-v2`'s stage that gave the box or None).
+type DetectionTuple = (Option<[u16; 4]>, f32, u32, u32, Option<&'static str>);
 
-fn detection_tuple(d: Detection) -> DetectionTuple {
+/// `d` as the Python half takes it, with the stage of `auto-v2`'s box on `frame`
+/// (`learned::Stage::name`, what `tirroi detect` prints; None for the other methods).
+fn detection_tuple(d: Detection, method: Method, frame: &Frame<'_>) -> DetectionTuple {
+    let stage = (method == Method::AutoV2)
+        .then(|| BANK.with(|b| b.borrow_mut().auto_v2_stage(frame, d.roi)))
+        .flatten()
+        .map(|s| s.name());
     (
         d.roi.map(|r: Roi| r.to_array()),
         d.score(),
         d.threshold,
         d.foreground_px,
+        stage,
     )
 }
 
@@ -223,7 +230,7 @@ fn detect(dn: PyReadonlyArrayDyn<'_, u16>, method: &str, bits: u8) -> PyResult<D
     let d = BANK
         .with(|b| b.borrow_mut().detect(m, &frame))
         .map_err(|e| bad(format!("{method}: {e}")))?;
-    Ok(detection_tuple(d))
+    Ok(detection_tuple(d, m, &frame))
 }
 
 /// `auto-v2` over a sequence of frames: the core's tracker (`tirroi detect --method
@@ -250,7 +257,7 @@ impl Tracker {
         let (d, _) = BANK
             .with(|b| b.borrow_mut().track_timed(&mut self.inner, &frame, 1))
             .map_err(|e| bad(format!("auto-v2: {e}")))?;
-        Ok(detection_tuple(d))
+        Ok(detection_tuple(d, Method::AutoV2, &frame))
     }
 
     /// Forgets the history (a new sequence).

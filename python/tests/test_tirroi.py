@@ -191,6 +191,9 @@ def test_detect_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> N
                 assert got.method == line["method"]
                 # The CLI prints the f32 score through JSON; the same f32 here.
                 assert np.float32(got.score) == np.float32(line["score"]), (frame.file, line)
+                # `auto-v2` names the stage that gave its box, as the CLI does.
+                assert got.stage == line.get("stage"), (frame.file, line)
+                assert (got.stage is not None) == (got.method == "auto-v2" and got.box is not None)
                 if got.box is None:
                     assert got.score == 0.0
 
@@ -215,6 +218,7 @@ def test_tracker_equals_cli(cli_datasets: Dict[str, Path], tirroi_bin: Path) -> 
                 want_box = None if line["bbox"] is None else tuple(line["bbox"])
                 assert got.box == want_box, (frame.file, line)
                 assert np.float32(got.score) == np.float32(line["score"]), (frame.file, line)
+                assert got.stage == line.get("stage"), (frame.file, line)
                 assert tracker.prior == got.box
             tracker.reset()
             assert tracker.prior is None

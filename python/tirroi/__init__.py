@@ -286,6 +286,9 @@ class Detection:
             otsu, a DN offset for adaptive, a gradient for wge, a DoG response in DN for
             dog, an edge threshold in DN for auto).
         foreground_px: pixels in the detector's mask before the box rule.
+        stage: for ``auto-v2`` with a box, the stage that gave it (``tracked``,
+            ``blob``, ``deep-space``, ``classifier``, ``spot`` or ``outline``: the
+            ``"stage"`` of ``tirroi detect --json``); None otherwise.
     """
 
     method: str
@@ -293,6 +296,7 @@ class Detection:
     score: float
     threshold: int
     foreground_px: int
+    stage: Optional[str] = None
 
 
 def detect(
@@ -315,10 +319,10 @@ def detect(
         ValueError: an unknown method, a frame that is not 2-D or too large, DN that do
             not fit ``bits``.
     """
-    box, score, threshold, foreground_px = _native.detect(
+    box, score, threshold, foreground_px, stage = _native.detect(
         _dn_uint16(dn), str(method), _bits(bits)
     )
-    return _detection(str(method), box, score, threshold, foreground_px)
+    return _detection(str(method), box, score, threshold, foreground_px, stage)
 
 
 class Tracker:
@@ -350,8 +354,10 @@ class Tracker:
         Raises:
             ValueError: a frame that is not 2-D or too large, DN that do not fit ``bits``.
         """
-        box, score, threshold, foreground_px = self._inner.step(_dn_uint16(dn), _bits(bits))
-        return _detection("auto-v2", box, score, threshold, foreground_px)
+        box, score, threshold, foreground_px, stage = self._inner.step(
+            _dn_uint16(dn), _bits(bits)
+        )
+        return _detection("auto-v2", box, score, threshold, foreground_px, stage)
 
     def reset(self) -> None:
         """Forgets the history: the next frame starts a new sequence."""
@@ -387,7 +393,12 @@ def _bits(bits: int) -> int:
 
 
 def _detection(
-    method: str, box: Optional[Sequence[int]], score: float, threshold: int, foreground_px: int
+    method: str,
+    box: Optional[Sequence[int]],
+    score: float,
+    threshold: int,
+    foreground_px: int,
+    stage: Optional[str],
 ) -> Detection:
     return Detection(
         method=method,
@@ -395,6 +406,7 @@ def _detection(
         score=float(score),
         threshold=int(threshold),
         foreground_px=int(foreground_px),
+        stage=None if stage is None else str(stage),
     )
 
 

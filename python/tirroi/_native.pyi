@@ -41,8 +41,9 @@ class Renderer:
 
 def detect(
     dn: npt.NDArray[np.uint16], method: str, bits: int
-) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int]:
-    """(box (x0, y0, x1, y1) px or None, score 0..1, threshold, foreground px)."""
+) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int, Optional[str]]:
+    """(box (x0, y0, x1, y1) px or None, score 0..1, threshold, foreground px, the
+    stage of ``auto-v2`` that gave the box or None)."""
 
 class Tracker:
     """``auto-v2`` over a sequence of frames (the core's tracker)."""
@@ -50,8 +51,9 @@ class Tracker:
     def __init__(self) -> None: ...
     def step(
         self, dn: npt.NDArray[np.uint16], bits: int
-    ) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int]:
-        """The next frame: (box or None, score 0..1, threshold, foreground px)."""
+    ) -> Tuple[Optional[Tuple[int, int, int, int]], float, int, int, Optional[str]]:
+        """The next frame: (box or None, score 0..1, threshold, foreground px, stage or
+        None)."""
     def reset(self) -> None:
         """Forgets the history."""
     @property
