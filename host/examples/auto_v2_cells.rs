@@ -49,7 +49,7 @@ use rayon::prelude::*;
 use tirroi_core::Detector;
 use tirroi_core::capacity::ConstInit;
 use tirroi_core::roi::auto::learned::{
-    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, for_each_cell_features, frame_segments,
+    AutoV2, AutoV2Scratch, AutoV2Work, BlobRule, Stage, for_each_cell_features, frame_segments,
     rated_spots,
     segments::{self, Segment},
 };
@@ -279,18 +279,9 @@ fn main() {
                     }
                     None => s.push_str(",,,,,,"),
                 }
-                // The stage whose box this is (what the score's scale is): the work's
-                // telemetry is set only by the stage that answered (`deep_space()`:
-                // stage 2c, 2d or 2e; `outline()`: stage 5f).
-                let work = scratch.work();
-                let stage = match d.roi {
-                    None => "none",
-                    Some(r) if work.spot().is_some_and(|(b, _)| b == r) => "spot",
-                    Some(_) if work.outline().is_some() => "outline",
-                    Some(_) if work.blob_won() => "blob",
-                    Some(_) if work.deep_space().is_some() => "deep-space",
-                    Some(_) => "classifier",
-                };
+                // The stage whose box this is (what the score's scale is), "none"
+                // without a box.
+                let stage = scratch.work().stage(d.roi).map_or("none", Stage::name);
                 let _ = writeln!(s, ",{stage}");
             }
             s

@@ -200,9 +200,8 @@ type DetectionTuple = (Option<[u16; 4]>, f32, u32, u32, Option<&'static str>);
 /// `d` as the Python half takes it, with the stage of `auto-v2`'s box on `frame`
 /// (`learned::Stage::name`, what `tirroi detect` prints; None for the other methods).
 fn detection_tuple(d: Detection, method: Method, frame: &Frame<'_>) -> DetectionTuple {
-    let stage = (method == Method::AutoV2)
-        .then(|| BANK.with(|b| b.borrow_mut().auto_v2_stage(frame, d.roi)))
-        .flatten()
+    let stage = BANK
+        .with(|b| b.borrow_mut().stage(method, frame, d.roi))
         .map(|s| s.name());
     (
         d.roi.map(|r: Roi| r.to_array()),

@@ -205,10 +205,7 @@ pub fn run(args: &DetectArgs) -> ExitCode {
             if args.track {
                 *prior = d.roi;
             }
-            let stage = (method == Method::AutoV2)
-                .then(|| bank.auto_v2_stage(&view, d.roi))
-                .flatten()
-                .map(|s| s.name());
+            let stage = bank.stage(method, &view, d.roi).map(|s| s.name());
             let file = path.to_string_lossy();
             let written = if json {
                 let line = DetectLine {

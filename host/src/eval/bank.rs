@@ -219,11 +219,19 @@ impl DetectorBank {
         Ok(timed)
     }
 
-    /// The stage of `auto-v2` that gave `answer`, its last call's box on `frame`
-    /// (`AutoV2Work::stage`, read from the scratch of the capacity that ran `frame`);
-    /// `None` for no box, or when that capacity's scratch was never used.
-    pub fn auto_v2_stage(&mut self, frame: &Frame<'_>, answer: Option<Roi>) -> Option<Stage> {
-        if fits::<tirroi_core::Reference>(frame) {
+    /// The stage of `auto-v2` that gave `answer`, the box of `method`'s last call on
+    /// `frame` (`AutoV2Work::stage`, read from the scratch of the capacity that ran
+    /// `frame`); `None` for the other methods, no box, or a capacity whose scratch was
+    /// never used.
+    pub fn stage(
+        &mut self,
+        method: Method,
+        frame: &Frame<'_>,
+        answer: Option<Roi>,
+    ) -> Option<Stage> {
+        if method != Method::AutoV2 {
+            None
+        } else if fits::<tirroi_core::Reference>(frame) {
             self.scratch.auto_v2().work().stage(answer)
         } else if fits::<Cap640x512>(frame) {
             self.scratch_640x512

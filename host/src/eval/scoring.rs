@@ -676,8 +676,8 @@ fn score_one(
     frame_score(timed, stage, method, row, path)
 }
 
-/// The `auto-v2` stage that gave `timed`'s box ([`DetectorBank::auto_v2_stage`]), as
-/// its name; `None` for the other methods, an error or no box.
+/// The `auto-v2` stage that gave `timed`'s box ([`DetectorBank::stage`]), as its
+/// name; `None` for the other methods, an error or no box.
 fn stage_of(
     bank: &mut DetectorBank,
     method: Method,
@@ -685,10 +685,7 @@ fn stage_of(
     timed: &Result<(Detection, f64), DetectError>,
 ) -> Option<&'static str> {
     let (d, _) = timed.as_ref().ok()?;
-    (method == Method::AutoV2)
-        .then(|| bank.auto_v2_stage(view, d.roi))
-        .flatten()
-        .map(|s| s.name())
+    bank.stage(method, view, d.roi).map(|s| s.name())
 }
 
 /// The group each `auto-v2` frame with a box gets, valued by the stage that gave it

@@ -220,21 +220,27 @@ impl Band<'_> {
             row_in.chunks_exact(RING_STRIDE_PX),
             row_out.chunks_exact(RING_STRIDE_PX),
         );
-        let tail = (ins.remainder().first(), outs.remainder().first());
+        // The odd row's last sampled column goes to the sums after the full chunks'.
+        let (tail, tail_column) = (
+            (ins.remainder().first(), outs.remainder().first()),
+            ins.len(),
+        );
+        // Pixel `a` enters column sums (`dn`, `sq`) where `b` leaves.
+        let enter = |dn: &mut u32, sq: &mut u32, a: u16, b: u16| {
+            let [a, b] = [a, b].map(|v| u32::from(v.min(max_dn) >> shift));
+            *dn = dn.wrapping_add(a).wrapping_sub(b);
+            *sq = sq.wrapping_add(a * a).wrapping_sub(b * b);
+        };
         let pixels = ins.map(|c| c[0]).zip(outs.map(|c| c[0]));
-        let mut n = 0usize;
         for ((dn, sq), (a, b)) in self.dn.iter_mut().zip(self.sq.iter_mut()).zip(pixels) {
-            let [a, b] = [a, b].map(|v| u32::from(v.min(max_dn) >> shift));
-            *dn = dn.wrapping_add(a).wrapping_sub(b);
-            *sq = sq.wrapping_add(a * a).wrapping_sub(b * b);
-            n += 1;
+            enter(dn, sq, a, b);
         }
-        if let ((Some(&a), Some(&b)), Some(dn), Some(sq)) =
-            (tail, self.dn.get_mut(n), self.sq.get_mut(n))
-        {
-            let [a, b] = [a, b].map(|v| u32::from(v.min(max_dn) >> shift));
-            *dn = dn.wrapping_add(a).wrapping_sub(b);
-            *sq = sq.wrapping_add(a * a).wrapping_sub(b * b);
+        if let ((Some(&a), Some(&b)), Some(dn), Some(sq)) = (
+            tail,
+            self.dn.get_mut(tail_column),
+            self.sq.get_mut(tail_column),
+        ) {
+            enter(dn, sq, a, b);
         }
     }
 }
