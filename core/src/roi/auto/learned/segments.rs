@@ -39,9 +39,10 @@ pub const MAX_SEGMENTS: usize = 96;
 /// component (each is a difference of two sums of two pixels, σ·2): 3 such σ leave a
 /// noise block in about e⁻⁴·⁵ ≈ 1 % (the magnitude of two Gaussian components is
 /// Rayleigh); such a block only matters beside a region, whose direction test it must
-/// also pass. Lower than the 4 σ before session 65 because the frame's σ estimate reads
-/// texture as noise (famAT: estimate over the true σ, median 1.16, 90th percentile
-/// 1.69), so an edge blurred by the optics fell under 4 estimated σ. Chosen on family
+/// also pass. Lower than the 4 σ before session 65: the frame's σ estimate also reads
+/// the fixed pattern and the Earth's pixel-scale texture as noise (famAT, over the
+/// temporal σ: Earth frames median 1.10, 90th percentile 1.65; deep space 0.96 and
+/// 1.58), and an edge blurred by the optics fell under 4 such σ. Chosen on family
 /// A with [`SEED_SIGMAS`] (4/8 → 3/6, `scripts/families.sh compare`, ½ convention):
 /// summed mean IoU +0.0034 (famA +0.0035, paper A +0.0032, fixtures A −0.0033, famAF
 /// 0); reported beside: famAT −0.0049, paper Tango A +0.0023; held out +0.0169 (famB
