@@ -54,7 +54,8 @@ pub const EDGE_SIGMAS: u32 = 3;
 
 /// A block seeds a region from this many noise σ of a component: twice the edge
 /// threshold, so regions start on real steps and grow into their weaker ends (noise
-/// alone seeds a block in about e⁻¹⁸: none in a frame). 8 before session 65, chosen
+/// alone seeds a block with probability e⁻¹⁸ ≈ 1.5·10⁻⁸: about 10⁻³ of the 81 000
+/// blocks of a frame). 8 before session 65, chosen
 /// with [`EDGE_SIGMAS`].
 pub const SEED_SIGMAS: u32 = 6;
 
@@ -89,7 +90,10 @@ const MIN_REGION_BLOCKS: u32 = 10;
 /// regions a few thousand more; a frame of edges everywhere (`plate-holes-2` of the
 /// worst-case set: every block an edge) would take every one of its 81 000 blocks,
 /// each testing 8 neighbours: 80 M Cortex-M7 instructions before this cap, about
-/// 2.4 M with it (≈ 290 per block).
+/// 2.4 M with it (≈ 290 per block). Since session 65's lower [`EDGE_SIGMAS`] a
+/// textured frame can reach it (`famAT/000234`: 24 segments under the cap, 65 without);
+/// 16 384 was measured and not taken (family A +0.0015 over the shipped thresholds,
+/// one more false alarm on the real Earth, twice the worst case's growth).
 pub const MAX_FRAME_BLOCKS: u32 = 8192;
 
 /// `cos(ANGLE_TOLERANCE_DEG)`.
