@@ -798,25 +798,27 @@ mod tests {
         assert_eq!(o.roi.x1, 89);
     }
 
+    /// The dark rectangle's four sides and `part`.
+    fn with_part(part: Segment) -> [Segment; 5] {
+        let body = dark_rectangle();
+        core::array::from_fn(|i| body.get(i).copied().unwrap_or(part))
+    }
+
     #[test]
     fn a_part_edge_square_to_the_outline_is_taken_in() {
         // A lone edge beside the dark rectangle's right side, parallel to its top (a
         // cylinder's side), 1.5 px away: its box joins; the same edge at 45° (a cloud's)
         // does not, nor one beyond the reach.
-        let body = dark_rectangle();
-        let with = |part: Segment| -> [Segment; 5] {
-            core::array::from_fn(|i| if i < 4 { body[i] } else { part })
-        };
         let along = seg(91.0, 40.0, 115.0, 40.0, 0.0, -1.0);
-        let o = strongest(&with(along), 160, 90).unwrap();
+        let o = strongest(&with_part(along), 160, 90).unwrap();
         assert_eq!((o.segments, o.corners), (4, 4), "{o:?}");
         assert_eq!(o.roi.x1, 116);
         let upright = seg(91.0, 30.0, 91.0, 55.0, 1.0, 0.0);
-        assert_eq!(strongest(&with(upright), 160, 90).unwrap().roi.x1, 92);
+        assert_eq!(strongest(&with_part(upright), 160, 90).unwrap().roi.x1, 92);
         let skew = seg(91.0, 40.0, 108.0, 57.0, 1.0, -1.0);
-        assert_eq!(strongest(&with(skew), 160, 90).unwrap().roi.x1, 90);
+        assert_eq!(strongest(&with_part(skew), 160, 90).unwrap().roi.x1, 90);
         let far = seg(99.0, 40.0, 120.0, 40.0, 0.0, -1.0);
-        assert_eq!(strongest(&with(far), 160, 90).unwrap().roi.x1, 90);
+        assert_eq!(strongest(&with_part(far), 160, 90).unwrap().roi.x1, 90);
     }
 
     #[test]
@@ -824,24 +826,20 @@ mod tests {
         // The part edge of the test above run on to the right: the outline's box spans
         // x 29.5–89.5 (60 px), so an edge may reach 60 px past it (x 149.5), no more (a
         // limb's straight piece running across the frame).
-        let body = dark_rectangle();
-        let with = |part: Segment| -> [Segment; 5] {
-            core::array::from_fn(|i| if i < 4 { body[i] } else { part })
-        };
         let part = seg(91.0, 40.0, 149.5, 40.0, 0.0, -1.0);
-        assert_eq!(strongest(&with(part), 200, 90).unwrap().roi.x1, 150);
+        assert_eq!(strongest(&with_part(part), 200, 90).unwrap().roi.x1, 150);
         let limb = seg(91.0, 40.0, 150.5, 40.0, 0.0, -1.0);
-        assert_eq!(strongest(&with(limb), 200, 90).unwrap().roi.x1, 90);
+        assert_eq!(strongest(&with_part(limb), 200, 90).unwrap().roi.x1, 90);
         // Running to the frame's border, it would have carried the box there.
         let across = seg(91.0, 40.0, 199.5, 40.0, 0.0, -1.0);
-        assert_eq!(strongest(&with(across), 200, 90).unwrap().roi.x1, 90);
+        assert_eq!(strongest(&with_part(across), 200, 90).unwrap().roi.x1, 90);
         // Downwards past the bottom (y 64.5) alike, in a frame 200 px high (3.5 px
         // beside the right side: no continuation of it).
         let down = seg(93.0, 45.0, 93.0, 124.5, 1.0, 0.0);
-        let o = strongest(&with(down), 200, 200).unwrap();
+        let o = strongest(&with_part(down), 200, 200).unwrap();
         assert_eq!((o.roi.x1, o.roi.y1), (94, 125), "{o:?}");
         let down = seg(93.0, 45.0, 93.0, 125.5, 1.0, 0.0);
-        let o = strongest(&with(down), 200, 200).unwrap();
+        let o = strongest(&with_part(down), 200, 200).unwrap();
         assert_eq!((o.roi.x1, o.roi.y1), (90, 65), "{o:?}");
     }
 
