@@ -44,10 +44,10 @@ use crate::roi::plane::Window;
 /// clusters, which on family A's target-less deep space (famAE, famAF) reach 8–11 σ
 /// at the 3×3 scale, while its far targets of signal-to-clutter ≥ 3 stand 12 σ and
 /// more. 12 since session 68 (8 before), chosen on family A (seeds 7001–7201, stage 2d
-/// on, `docs/detectors.md` § Session 68): 8 / 10 / **12** / 14 / 16 → summed mean IoU
-/// +0.0269 / +0.0237 / **+0.0233** / +0.0212 / +0.0201 against the stage off, false
-/// alarms on famAE 18 / 7 / **6** / 6 / 6 of 300 (6 with the stage off); the lowest
-/// value that adds none there.
+/// on, its boxes at 4 σ, `docs/detectors.md` § Session 68): 8 (2-px boxes allowed) /
+/// 10 / **12** / 14 / 16 → summed mean IoU +0.0269 / +0.0237 / **+0.0233** / +0.0212 /
+/// +0.0201 against the stage off, false alarms on famAE 18 / 7 / **6** / 6 / 6 of 300
+/// (6 with the stage off); the lowest value that adds none there.
 pub const MIN_Z: u32 = 12;
 
 /// Narrowest box of stage 2d, px (each side): the optics blur a point of the scene over
