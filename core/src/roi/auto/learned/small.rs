@@ -81,7 +81,7 @@ pub const SEARCH_HALF_PX: usize = 14;
 /// A pixel joins the box from this many noise σ above the ring. The faint faces of a
 /// far target in eclipse lie 2–4 σ above the sky, and at 4 σ (one noise pixel in
 /// 30 000, before session 68) the box stopped at its brightest face, inside the truth:
-/// on family A 18 of 33 stage-2d boxes hit. At 2 σ a noise pixel joins a side with a
+/// on family A 12 of 31 stage-2d boxes hit. At 2 σ a noise pixel joins a side with a
 /// few per cent odds, so the box is at times a pixel wider, which costs less than a
 /// missing face, and a box that runs on into the noise reaches [`SEARCH_HALF_PX`] and is
 /// dropped. Chosen on family A (session 68, with [`MIN_Z`] 12): 4 / 3 / **2** σ →
