@@ -42,6 +42,17 @@ pub const GROWN: u8 = 2;
 /// partly grown, deterministically.
 pub const MAX_PASSES: usize = 32;
 
+/// A growth ends at a step, not in a fade: the median departure of the cells just
+/// outside the grown body (8-adjacent to a grown cell, not marked) must stay under
+/// this share of a spread, %. A target's faces end at their outline, beyond which the
+/// cells sit at the background's level (median departure 0–0.8 spread on paper A's
+/// grown bodies); a growth through the Earth's ramp stops where the ramp falls just
+/// under the bar (1.1–1.8 spreads on the real Earth image's overgrown boxes), the
+/// "step vs ramp" rule of `auto` applied to the body. Chosen on family A (seeds
+/// 7001–7201, ½ convention; docs/detectors.md § Session 69): 75 / 100 / 150 % →
+/// summed mean IoU +0.0000 / +0.0013 / +0.0012 against no such test.
+pub const MAX_FADE_PERCENT: u32 = 100;
+
 /// 1.4826 (σ of a normal law per median absolute deviation), ‰.
 const MAD_TO_SIGMA_PERMILLE: u32 = 1483;
 
@@ -213,6 +224,33 @@ fn grow(
     marks.iter().take(n).filter(|&&m| m != 0).count()
 }
 
+/// Whether the grown body (cells marked [`GROWN`] in `marks`, a `pw × ph` plane)
+/// ends in a fade: the median departure from `level` of the unmarked cells 8-adjacent
+/// to a grown cell is at least [`MAX_FADE_PERCENT`] of `spread` (see there). False
+/// without such cells. One pass over the plane to count them, and the median by
+/// binned passes ([`select_binned`]); no buffer.
+fn fades(marks: &[u8], mean_dn: &[u16], (pw, ph): (usize, usize), level: u32, spread: u32) -> bool {
+    let n = (pw * ph).min(marks.len()).min(mean_dn.len());
+    let outside = |i: usize| {
+        let (x, y) = (i % pw.max(1), i / pw.max(1));
+        marks.get(i) == Some(&0)
+            && (y.saturating_sub(1)..(y + 2).min(ph)).any(|ny| {
+                (x.saturating_sub(1)..(x + 2).min(pw))
+                    .any(|nx| marks.get(ny * pw + nx) == Some(&GROWN))
+            })
+    };
+    // Departures in hundredths of a spread, capped (a cell far off counts as far).
+    const CAP: u32 = 100_000;
+    let departures = || {
+        (0..n).filter(move |&i| outside(i)).map(move |i| {
+            let d = mean_dn.get(i).map_or(0, |&m| u32::from(m).abs_diff(level));
+            (d.saturating_mul(100) / spread.max(1)).min(CAP)
+        })
+    };
+    let k = departures().count();
+    k > 0 && select_binned(departures, k / 2, CAP) >= MAX_FADE_PERCENT
+}
+
 /// Pixels of column `x` (or row, `vertical` false) over `span` departing from
 /// `level` by at least `thr` DN.
 fn departing(
@@ -273,7 +311,10 @@ pub(crate) fn body_box(
     let thr = spread.saturating_mul(u32::from(p.k_sigma));
     let before = marks.iter().filter(|&&m| m != 0).count();
     let after = grow(marks, mean_dn, plane, level, thr);
-    if after == before || after * 1000 > n * usize::from(p.max_share_permille) {
+    if after == before
+        || after * 1000 > n * usize::from(p.max_share_permille)
+        || fades(marks, mean_dn, plane, level, spread)
+    {
         return roi;
     }
     let Some(gb) = marked_box(marks, pw) else {
@@ -425,6 +466,87 @@ mod tests {
             assert_eq!(marks, want, "seed {seed}");
             assert_eq!(n, want.iter().filter(|&&m| m != 0).count());
         }
+    }
+
+    /// The fade test against a brute force: the sorted departures of the unmarked
+    /// cells 8-adjacent to a grown cell, their element `k / 2` against the bar.
+    #[test]
+    fn fades_equals_the_sorted_neighbours() {
+        let (pw, ph) = (41usize, 31usize);
+        for seed in 1..40u32 {
+            let mut r = rng(seed);
+            let mean: Vec<u16> = (0..pw * ph).map(|_| 900 + (r() % 200) as u16).collect();
+            let marks: Vec<u8> = (0..pw * ph)
+                .map(|_| match r() % 7 {
+                    0 => GROWN,
+                    1 => WINNER,
+                    _ => 0,
+                })
+                .collect();
+            let spread = 1 + r() % 60;
+            let mut deps = Vec::new();
+            for y in 0..ph {
+                for x in 0..pw {
+                    if marks[y * pw + x] != 0 {
+                        continue;
+                    }
+                    let mut near = false;
+                    for ny in y.saturating_sub(1)..(y + 2).min(ph) {
+                        for nx in x.saturating_sub(1)..(x + 2).min(pw) {
+                            near |= marks[ny * pw + nx] == GROWN;
+                        }
+                    }
+                    if near {
+                        let d = u32::from(mean[y * pw + x]).abs_diff(1000);
+                        deps.push((d * 100 / spread).min(100_000));
+                    }
+                }
+            }
+            deps.sort_unstable();
+            let want = !deps.is_empty() && deps[deps.len() / 2] >= MAX_FADE_PERCENT;
+            assert_eq!(
+                fades(&marks, &mean, (pw, ph), 1000, spread),
+                want,
+                "seed {seed}"
+            );
+        }
+        // No grown cell, or empty planes: no fade.
+        assert!(!fades(&[WINNER; 4], &[5000; 4], (2, 2), 0, 1));
+        assert!(!fades(&[], &[], (41, 31), 0, 1));
+    }
+
+    /// A body ends at a step; a growth through a ramp (falling a quarter spread per
+    /// cell away from the winner) ends in a fade.
+    #[test]
+    fn a_growth_through_a_ramp_fades() {
+        let (pw, ph) = (41usize, 31usize);
+        let (level, spread) = (1000u32, 20u32);
+        // Chebyshev distance of a cell from the winner cell (20, 15).
+        let dist = |i: usize| {
+            let (x, y) = ((i % pw) as i64, (i / pw) as i64);
+            (x - 20).abs().max((y - 15).abs()) as u32
+        };
+        let grown = |mean: &[u16]| -> Vec<u8> {
+            let mut marks = std::vec![0u8; pw * ph];
+            marks[15 * pw + 20] = WINNER;
+            grow(&mut marks, mean, (pw, ph), level, 3 * spread);
+            marks
+        };
+        // A step: a body of radius 2 at 5 spreads, the background at the level.
+        let step: Vec<u16> = (0..pw * ph)
+            .map(|i| if dist(i) <= 2 { level + 5 * spread } else { level } as u16)
+            .collect();
+        let marks = grown(&step);
+        assert_eq!(marks.iter().filter(|&&m| m == GROWN).count(), 24);
+        assert!(!fades(&marks, &step, (pw, ph), level, spread));
+        // A ramp: 4 spreads at the winner, a quarter less per cell, 1.5 at the least;
+        // the growth (bar 3 spreads) stops at 4 cells, its neighbours at 2.75 spreads.
+        let ramp: Vec<u16> = (0..pw * ph)
+            .map(|i| (level + 4 * spread - (spread * dist(i) / 4).min(spread * 5 / 2)) as u16)
+            .collect();
+        let marks = grown(&ramp);
+        assert_eq!(marks.iter().filter(|&&m| m == GROWN).count(), 80);
+        assert!(fades(&marks, &ramp, (pw, ph), level, spread));
     }
 
     /// A frame: textured background (noise of ±`tex` DN), a body of two faces, one
