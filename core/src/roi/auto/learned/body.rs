@@ -117,8 +117,13 @@ struct CellBox {
 
 /// The box of the cells marked non-zero, `None` without any.
 fn marked_box(marks: &[u8], pw: usize) -> Option<CellBox> {
+    box_where(marks, pw, |m| m != 0)
+}
+
+/// The box of the cells whose mark passes `keep`, `None` without any.
+fn box_where(marks: &[u8], pw: usize, keep: impl Fn(u8) -> bool) -> Option<CellBox> {
     let mut b: Option<CellBox> = None;
-    for (i, _) in marks.iter().enumerate().filter(|(_, m)| **m != 0) {
+    for (i, _) in marks.iter().enumerate().filter(|(_, m)| keep(**m)) {
         let (x, y) = (i % pw.max(1), i / pw.max(1));
         b = Some(match b {
             None => CellBox {
@@ -237,24 +242,7 @@ fn fades(marks: &[u8], mean_dn: &[u16], (pw, ph): (usize, usize), level: u32, sp
     // The grown cells' box one cell wider: the cells beside them lie in it (a scan of
     // the body's box, not of the plane: the M7's `deep-space` frame took 0.7 M
     // instructions more with whole-plane scans).
-    let mut grown: Option<CellBox> = None;
-    for (i, _) in marks.iter().enumerate().filter(|(_, m)| **m == GROWN) {
-        let (x, y) = (i % pw.max(1), i / pw.max(1));
-        grown = Some(match grown {
-            None => CellBox {
-                x0: x,
-                y0: y,
-                x1: x,
-                y1: y,
-            },
-            Some(c) => CellBox {
-                x0: c.x0.min(x),
-                y0: c.y0.min(y),
-                x1: c.x1.max(x),
-                y1: c.y1.max(y),
-            },
-        });
-    }
+    let grown = box_where(marks, pw, |m| m == GROWN);
     let Some(g) = grown else {
         return false;
     };
