@@ -45,9 +45,10 @@ pub const MAX_PASSES: usize = 32;
 /// A growth ends at a step, not in a fade: the median departure of the cells just
 /// outside the grown body (8-adjacent to a grown cell, not marked) must stay under
 /// this share of a spread, %. A target's faces end at their outline, beyond which the
-/// cells sit at the background's level (median departure 0–0.8 spread on paper A's
-/// grown bodies); a growth through the Earth's ramp stops where the ramp falls just
-/// under the bar (1.1–1.8 spreads on the real Earth image's overgrown boxes), the
+/// cells sit at the background's level (median departure 0–0.8 spread on 7 of the 8
+/// paper A frames stage 6 helps most, 1.4 on the eighth); a growth through the Earth's
+/// ramp stops where the ramp falls just under the bar (1.1–1.8 spreads on 4 of 5
+/// overgrown real-Earth boxes looked at), the
 /// "step vs ramp" rule of `auto` applied to the body. Chosen on family A (seeds
 /// 7001–7201, ½ convention; docs/detectors.md § Session 69): 75 / 100 / 150 % →
 /// summed mean IoU +0.0000 / +0.0013 / +0.0012 against no such test.
@@ -232,8 +233,10 @@ fn grow(
 /// Whether the grown body (cells marked [`GROWN`] in `marks`, a `pw × ph` plane)
 /// ends in a fade: the median departure from `level` of the unmarked cells 8-adjacent
 /// to a grown cell is at least [`MAX_FADE_PERCENT`] of `spread` (see there). False
-/// without such cells. One pass over the plane to count them, and the median by
-/// binned passes ([`select_binned`]); no buffer.
+/// without such cells. One pass over the plane for the grown cells' box, then over that
+/// box one pass to count the neighbours and two binned passes for their median
+/// ([`select_binned`]), each re-testing a cell's 3×3 neighbourhood: no buffer (the
+/// marks plane is the caller's and read again after this).
 fn fades(marks: &[u8], mean_dn: &[u16], (pw, ph): (usize, usize), level: u32, spread: u32) -> bool {
     let n = (pw * ph).min(marks.len()).min(mean_dn.len());
     let Some(marks) = marks.get(..n) else {
